@@ -1,0 +1,121 @@
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/rotation/motion_analysis.hpp"
+#include "parse.hpp"
+
+namespace granmem::app {
+namespace {
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream s(text);
+  for (std::string item; std::getline(s, item, ',');) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+// A few rows of the per-frame table, so the user sees the run's story at a glance.
+void print_per_frame(const Table& p, const std::string& unit) {
+  const std::size_t rows = p.rows();
+  std::cout << "  frame       n    mean_dr [" << unit << "]  median_dr    mean_theta_axis [deg]\n";
+  for (std::size_t r = 0; r < rows; ++r) {
+    if (rows > 12 && r == 5) {
+      std::cout << "  ...\n";
+      r = rows - 5;
+    }
+    std::cout << "  " << std::setw(5) << p["frame"].values[r] << "  " << std::setw(6)
+              << p["n"].values[r] << "  " << std::setw(12) << std::setprecision(5)
+              << p["mean_dr"].values[r] << "  " << std::setw(12) << p["median_dr"].values[r] << "  "
+              << std::setw(10) << p["mean_theta_axis_deg"].values[r] << "\n";
+  }
+}
+
+}  // namespace
+
+void add_analyze(CLI::App& app) {
+  struct Args {
+    std::string run, out, wall_distance = "0", box, hole_contacts = "keep", pdf, pdf_frames,
+                          pdf_scale = "linear", pdf_range;
+    bool subtract_drift = false;
+    std::size_t pdf_bins = 50;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "analyze", "Displacements and rotations between consecutive frames, per-frame means, pdfs");
+  cmd->add_option("run", args->run, "trajectory store (.h5)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--out,-o", args->out, "output folder")->required();
+  cmd->add_flag("--subtract-drift", args->subtract_drift,
+                "remove the mean displacement of the analysed grains, frame by frame");
+  cmd->add_option("--wall-distance", args->wall_distance,
+                  "leave out grains whose centre is closer than this to a container face "
+                  "(run's length unit, or give one: 0.5cm)")
+      ->capture_default_str();
+  cmd->add_option("--box", args->box,
+                  "container xmin,ymin,zmin,xmax,ymax,zmax (run's unit); default the run's box");
+  cmd->add_option("--hole-contacts", args->hole_contacts,
+                  "grains touching through their hole: keep, exclude-rotations, exclude")
+      ->check(CLI::IsMember({"keep", "exclude-rotations", "exclude"}))
+      ->capture_default_str();
+  cmd->add_option("--pdf", args->pdf,
+                  "quantities for pdfs, comma list (dr,dx,dy,dz,theta_axis_deg,rot_disp,"
+                  "theta_full_deg); default all the run has");
+  cmd->add_option("--pdf-frames", args->pdf_frames,
+                  "FIRST:LAST frames (labels) pooled into the pdfs; default all");
+  cmd->add_option("--pdf-bins", args->pdf_bins, "number of bins")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--pdf-scale", args->pdf_scale, "linear or log bins")
+      ->check(CLI::IsMember({"linear", "log"}))
+      ->capture_default_str();
+  cmd->add_option("--pdf-range", args->pdf_range, "LO:HI of the bins; default the data's range");
+
+  cmd->callback([args, cmd] {
+    const TrajectoryReader run(args->run);
+    const RunHeader& h = run.header();
+    AnalysisOptions options;
+    options.motion.subtract_drift = args->subtract_drift;
+    options.motion.wall_distance =
+        parse_length(args->wall_distance, h.length_unit, "--wall-distance");
+    if (!args->box.empty()) options.motion.box = parse_box(args->box, "--box");
+    options.motion.hole_contacts = args->hole_contacts == "exclude" ? HoleContactPolicy::exclude
+                                   : args->hole_contacts == "exclude-rotations"
+                                       ? HoleContactPolicy::exclude_rotations
+                                       : HoleContactPolicy::keep;
+    options.pdf_quantities = split_list(args->pdf);
+    if (!args->pdf_frames.empty()) {
+      options.pdf_frames = parse_int_range(args->pdf_frames, "--pdf-frames");
+    }
+    options.density.bins = args->pdf_bins;
+    options.density.scale = args->pdf_scale == "log" ? BinScale::logarithmic : BinScale::linear;
+    if (!args->pdf_range.empty())
+      options.density.range = parse_range(args->pdf_range, "--pdf-range");
+
+    const MotionAnalysis a = analyze_motion(run, options);
+    std::map<std::string, std::string> used;
+    for (const auto& [key, value] : used_options(*cmd))
+      used[key.substr(key.find('/') + 1)] = value;
+    const auto written =
+        write_motion_analysis(a, args->out, {"granmem analyze " + args->run}, used);
+
+    const bool radius_known =
+        std::any_of(h.radius.begin(), h.radius.end(), [](double r) { return std::isfinite(r); });
+    if ((h.has_axis || h.has_orientation) && !radius_known) {
+      std::cerr << "granmem: note: " << args->run
+                << " has no grain radius, so rot_disp is nan (import with --radius)\n";
+    }
+    std::cout << args->run << ": " << a.displacements.rows() << " displacements over "
+              << a.per_frame.rows() << " frame pairs, lengths in " << a.length_unit << "\n";
+    print_per_frame(a.per_frame, a.length_unit);
+    for (const auto& path : written)
+      std::cout << "wrote " << path.string() << "\n";
+  });
+}
+
+}  // namespace granmem::app

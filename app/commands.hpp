@@ -1,0 +1,20 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <map>
+#include <string>
+
+// The `granmem` subcommands. Each registers its options on `app`; its callback maps them
+// onto a library options struct, calls the library and prints the summary.
+namespace granmem::app {
+
+void add_import(CLI::App& app);
+void add_info(CLI::App& app);
+void add_analyze(CLI::App& app);
+void add_export(CLI::App& app);
+
+// The options of a subcommand as actually used (given or default), "<command>/<option>"
+// -> value, for the output's /parameters.
+std::map<std::string, std::string> used_options(const CLI::App& command);
+
+}  // namespace granmem::app

@@ -1,0 +1,70 @@
+#include <iostream>
+
+#include "commands.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/import_table.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/core/xdmf.hpp"
+#include "parse.hpp"
+
+namespace granmem::app {
+
+void add_import(CLI::App& app) {
+  struct Args {
+    std::string table, out, length_unit = "voxel", voxel_size, box, sample = kSampleEndOfCycle;
+    double radius = 0;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "import",
+      "Read a long-form CSV of tracked grains (frame,particle,x,y,z[,ax,ay,az][,radius]"
+      "[,hole_contact]) into a trajectory store");
+  cmd->add_option("table", args->table, "CSV table, one row per grain per frame")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
+  cmd->add_option("--length-unit", args->length_unit, "unit of x,y,z and radius in the table")
+      ->check(CLI::IsMember({"m", "cm", "mm", "um", "voxel"}))
+      ->capture_default_str();
+  cmd->add_option("--voxel-size", args->voxel_size,
+                  "voxel size X[,Y,Z] with a unit, e.g. 0.05,0.05,0.075mm (voxel tables)");
+  CLI::Option* radius =
+      cmd->add_option("--radius", args->radius, "grain radius for tables without a radius column");
+  cmd->add_option("--box", args->box,
+                  "container xmin,ymin,zmin,xmax,ymax,zmax in the table's unit");
+  cmd->add_option("--sample", args->sample, "what a frame is")
+      ->check(CLI::IsMember({kSampleEndOfCycle, kSampleFullCompression, kSampleInCycle}))
+      ->capture_default_str();
+
+  cmd->callback([args, cmd, radius] {
+    ImportOptions options;
+    options.length_unit = args->length_unit;
+    if (radius->count()) options.radius = args->radius;
+    options.sample = args->sample;
+    if (!args->voxel_size.empty()) {
+      const std::vector<Quantity> v = parse_quantity_list(args->voxel_size, "--voxel-size");
+      if (v.size() != 1 && v.size() != 3) {
+        throw Error("--voxel-size '" + args->voxel_size + "': expected one size or three (x,y,z)");
+      }
+      options.voxel_size = v.size() == 1 ? Eigen::Vector3d::Constant(v[0].value)
+                                         : Eigen::Vector3d(v[0].value, v[1].value, v[2].value);
+      options.voxel_size_unit = v[0].unit;
+    }
+    if (!args->box.empty()) options.box = parse_box(args->box, "--box");
+
+    ImportSummary summary;
+    Trajectories run = import_table(args->table, options, &summary);
+    run.header.parameters = used_options(*cmd);
+    write_trajectories(args->out, run);
+
+    std::cout << "imported " << summary.rows << " rows of " << args->table << ": " << summary.frames
+              << " frames, " << summary.grains << " grains, " << summary.missing
+              << " missing (grain, frame) entries";
+    if (run.header.has_axis) std::cout << ", cavity axis in " << summary.axes_known << " rows";
+    std::cout << "\nlengths in " << summary.length_unit << "\nwrote " << args->out << " and "
+              << xdmf_path(args->out).string() << "\n";
+  });
+}
+
+}  // namespace granmem::app

@@ -1,0 +1,30 @@
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"granmem: tracked grains and DEM runs of cyclically compressed packings"};
+  app.set_version_flag("--version", granmem::kVersion);
+  app.set_config("--config", "", "TOML file of options, one [section] per command");
+  app.require_subcommand(1);
+  app.fallthrough();  // --config may follow the command name
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return std::string("granmem: error: ") + e.what() + " (see granmem --help)\n";
+  });
+  granmem::app::add_import(app);
+  granmem::app::add_info(app);
+  granmem::app::add_analyze(app);
+  granmem::app::add_export(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "granmem: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,74 @@
+#include "parse.hpp"
+
+#include <cmath>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem::app {
+namespace {
+
+std::pair<std::string, std::string> split_colon(const std::string& text,
+                                                const std::string& option) {
+  const std::size_t colon = text.find(':');
+  if (colon == std::string::npos || text.find(':', colon + 1) != std::string::npos) {
+    throw Error(option + " '" + text + "': expected FIRST:LAST");
+  }
+  return {text.substr(0, colon), text.substr(colon + 1)};
+}
+
+double plain_number(const std::string& text, const std::string& option) {
+  const Quantity q = parse_quantity(text, option);
+  if (!q.unit.empty()) throw Error(option + " '" + text + "': expected a plain number");
+  return q.value;
+}
+
+}  // namespace
+
+Box parse_box(const std::string& text, const std::string& option) {
+  const std::vector<Quantity> v = parse_quantity_list(text, option);
+  if (v.size() != 6 || !v.front().unit.empty()) {
+    throw Error(option + " '" + text +
+                "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax in the table's unit");
+  }
+  Box box;
+  for (int k = 0; k < 3; ++k) {
+    box.lower[k] = v[std::size_t(k)].value;
+    box.edges[k] = v[std::size_t(k) + 3].value - box.lower[k];
+  }
+  if (!(box.edges.array() > 0).all() || !box.lower.allFinite() || !box.edges.allFinite()) {
+    throw Error(option + " '" + text + "': each max must be greater than its min");
+  }
+  return box;
+}
+
+std::pair<std::int64_t, std::int64_t> parse_int_range(const std::string& text,
+                                                      const std::string& option) {
+  const auto [a, b] = split_colon(text, option);
+  const double lo = plain_number(a, option), hi = plain_number(b, option);
+  if (lo != std::floor(lo) || hi != std::floor(hi)) {
+    throw Error(option + " '" + text + "': expected whole frame numbers");
+  }
+  return {static_cast<std::int64_t>(lo), static_cast<std::int64_t>(hi)};
+}
+
+std::pair<double, double> parse_range(const std::string& text, const std::string& option) {
+  const auto [a, b] = split_colon(text, option);
+  return {plain_number(a, option), plain_number(b, option)};
+}
+
+double parse_length(const std::string& text, const std::string& run_unit,
+                    const std::string& option) {
+  const Quantity q = parse_quantity(text, option);
+  if (!std::isfinite(q.value) || q.value < 0) {
+    throw Error(option + " '" + text + "': expected a non-negative length");
+  }
+  if (q.unit.empty() || q.unit == run_unit) return q.value;
+  if (!is_physical_length_unit(q.unit) || !is_physical_length_unit(run_unit)) {
+    throw Error(option + " '" + text + "': cannot convert " + q.unit + " to the run's unit " +
+                run_unit);
+  }
+  return convert_length(q.value, q.unit, run_unit);
+}
+
+}  // namespace granmem::app

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "granmem/core/trajectories.hpp"
+
+// Parsers for option values that CLI11 passes through as text.
+namespace granmem::app {
+
+// "xmin,ymin,zmin,xmax,ymax,zmax" -> Box.
+Box parse_box(const std::string& text, const std::string& option);
+// "A:B" -> (A, B), integers.
+std::pair<std::int64_t, std::int64_t> parse_int_range(const std::string& text,
+                                                      const std::string& option);
+// "LO:HI" -> (LO, HI), numbers.
+std::pair<double, double> parse_range(const std::string& text, const std::string& option);
+// A length with an optional unit, in `run_unit`: "0.5" (run unit), "0.5 cm".
+double parse_length(const std::string& text, const std::string& run_unit,
+                    const std::string& option);
+
+}  // namespace granmem::app

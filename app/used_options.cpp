@@ -1,0 +1,23 @@
+#include "commands.hpp"
+
+namespace granmem::app {
+
+std::map<std::string, std::string> used_options(const CLI::App& command) {
+  std::map<std::string, std::string> used;
+  for (const CLI::Option* opt : command.get_options()) {
+    const std::string name =
+        opt->get_lnames().empty() ? opt->get_name() : opt->get_lnames().front();
+    if (name == "help" || name.empty()) continue;
+    std::string value;
+    if (opt->count() > 0) {
+      for (const std::string& r : opt->results())
+        value += (value.empty() ? "" : ",") + r;
+    } else {
+      value = opt->get_default_str();
+    }
+    used[command.get_name() + "/" + name] = value;
+  }
+  return used;
+}
+
+}  // namespace granmem::app

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "granmem/core/trajectories.hpp"
+
+namespace granmem {
+
+// How to read a long-form table of tracked grains (trackpy, a lab's MATLAB code):
+// one row per grain per frame, columns frame,particle,x,y,z and optionally ax,ay,az
+// (cavity axis, any length, any sign), radius and hole_contact (0/1), in any order.
+struct ImportOptions {
+  // Unit of x, y, z and radius in the table: m, cm, mm, um, or voxel.
+  std::string length_unit = "voxel";
+  // With voxel coordinates: the voxel size (x, y, z) in `voxel_size_unit`. Positions, axes
+  // and radii are then turned into lengths, axis by axis (radius with the x size).
+  std::optional<Eigen::Vector3d> voxel_size;
+  std::string voxel_size_unit;
+  // Radius of every grain when the table has no radius column (table's unit).
+  std::optional<double> radius;
+  // Container as (xmin, ymin, zmin, xmax, ymax, zmax) in the table's unit.
+  std::optional<Box> box;
+  std::string sample = kSampleEndOfCycle;
+};
+
+struct ImportSummary {
+  std::size_t rows = 0;
+  std::size_t frames = 0;
+  std::size_t grains = 0;
+  std::size_t missing = 0;     // (frame, grain) pairs with no row
+  std::size_t axes_known = 0;  // rows with a cavity axis
+  std::string length_unit;     // unit of the stored positions
+};
+
+// Reads the table into a run: frames in increasing `frame` order (step = frame label),
+// grains in increasing `particle` order (id = particle label). A grain missing from a
+// frame gets NaN. Throws Error naming file, line and column for bad rows.
+Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
+                          ImportSummary* summary = nullptr);
+
+}  // namespace granmem

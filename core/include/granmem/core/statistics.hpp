@@ -1,0 +1,41 @@
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "granmem/core/table.hpp"
+
+namespace granmem {
+
+// Count, mean, median and mean square of the finite values (NaN marks "not measured").
+struct Summary {
+  std::size_t count = 0;
+  double mean = 0;
+  double median = 0;
+  double mean_square = 0;
+};
+Summary summarize(const std::vector<double>& values);
+
+enum class BinScale { linear, logarithmic };
+
+struct DensityOptions {
+  std::size_t bins = 50;
+  BinScale scale = BinScale::linear;
+  // Histogram range; default the finite values' min and max (smallest positive value for
+  // logarithmic bins).
+  std::optional<std::pair<double, double>> range;
+};
+
+// The probability density of `values` in bins of equal width (linear) or equal ratio
+// (logarithmic): count / (finite values * bin width), so that it integrates to the
+// fraction of values inside the range (1 with the default range). NaN values are not
+// counted; values outside the range, zeros on log bins among them, count in the
+// normalisation only. Columns: bin_lo, bin_hi, bin_center (geometric centre for log
+// bins), count, density. Throws Error if the range is empty or invalid.
+Table probability_density(const std::vector<double>& values, const DensityOptions& options,
+                          const std::string& unit = "");
+
+}  // namespace granmem

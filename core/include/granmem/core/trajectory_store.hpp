@@ -1,0 +1,72 @@
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "granmem/core/hdf5.hpp"
+#include "granmem/core/trajectories.hpp"
+
+// The trajectory store: one run, experimental or simulated, in one HDF5 file laid out as
+// H5MD (see docs/FORMAT.md):
+//   /h5md                                   version; author, creator groups
+//   /particles/grains/position/{value[T,N,3], step[T], time[T]}
+//   /particles/grains/axis/...              [T,N,3] cavity axis, unsigned unit vector
+//   /particles/grains/orientation/...       [T,N,4] quaternion (w,x,y,z)
+//   /particles/grains/hole_contact/...      [T,N]   uint8 flag
+//   /particles/grains/{id,radius}[N], box/edges[3], box/offset[3]
+//   /observables/<name>/{value,step,time}
+//   /parameters/<producer>@<key>, /parameters/voxel_size[3]
+// Every dataset has a `unit` attribute.
+namespace granmem {
+
+// Writes a run frame by frame into a temporary file; commit() renames it into place and
+// writes the XDMF sidecar (<name>.xmf) that lets ParaView open it. Dropped without
+// commit(), it leaves nothing behind and any existing file of that name untouched.
+class TrajectoryWriter {
+ public:
+  TrajectoryWriter(const std::filesystem::path& path, RunHeader header);
+  ~TrajectoryWriter();
+  TrajectoryWriter(const TrajectoryWriter&) = delete;
+  TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
+
+  void append(const Frame& frame);
+  void set_observable(const std::string& name, Observable observable);
+  std::size_t frame_count() const;
+  void commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Reads a run: the header and observables at once, frames one at a time, so that runs
+// larger than memory can be streamed.
+class TrajectoryReader {
+ public:
+  explicit TrajectoryReader(const std::filesystem::path& path);
+  ~TrajectoryReader();
+  TrajectoryReader(TrajectoryReader&&) noexcept;
+
+  const RunHeader& header() const;
+  std::size_t frame_count() const;
+  const std::vector<std::int64_t>& steps() const;
+  const std::vector<double>& times() const;
+  const std::map<std::string, Observable>& observables() const;
+  Frame read_frame(std::size_t t) const;
+  const std::string& file_name() const;
+  const h5::File& file() const;
+  // Path of the particles group, e.g. "/particles/grains".
+  const std::string& particles_group() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+void write_trajectories(const std::filesystem::path& path, const Trajectories& run);
+Trajectories read_trajectories(const std::filesystem::path& path);
+
+}  // namespace granmem

@@ -1,0 +1,192 @@
+#include "granmem/core/import_table.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_map>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem {
+namespace {
+
+std::string at(const std::filesystem::path& csv, std::size_t line) {
+  return csv.string() + " line " + std::to_string(line);
+}
+
+// An integer label (frame or particle) stored in a double column.
+std::int64_t label(double v, const std::filesystem::path& csv, std::size_t line,
+                   const char* column) {
+  if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 9e15) {
+    throw Error(at(csv, line) + ", column '" + column + "': expected an integer label, found " +
+                (std::isnan(v) ? std::string("nothing") : std::to_string(v)));
+  }
+  return static_cast<std::int64_t>(v);
+}
+
+std::vector<std::int64_t> sorted_unique(std::vector<std::int64_t> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+std::size_t index_of(const std::vector<std::int64_t>& sorted, std::int64_t value) {
+  return static_cast<std::size_t>(std::lower_bound(sorted.begin(), sorted.end(), value) -
+                                  sorted.begin());
+}
+
+}  // namespace
+
+Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
+                          ImportSummary* summary) {
+  const std::string& unit = options.length_unit;
+  if (!is_length_unit(unit)) {
+    throw Error("--length-unit '" + unit + "': expected one of m, cm, mm, um, voxel");
+  }
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();  // table unit -> stored unit, per axis
+  std::string stored_unit = unit;
+  if (options.voxel_size) {
+    if (unit != "voxel") {
+      throw Error("--voxel-size applies to voxel coordinates, but --length-unit is " + unit);
+    }
+    if (!is_physical_length_unit(options.voxel_size_unit)) {
+      throw Error("--voxel-size needs a length unit (m, cm, mm or um), e.g. 0.05,0.05,0.075mm");
+    }
+    if (!(options.voxel_size->array() > 0).all() || !options.voxel_size->allFinite()) {
+      throw Error("--voxel-size: expected three positive sizes");
+    }
+    scale = *options.voxel_size;
+    stored_unit = options.voxel_size_unit;
+  }
+
+  if (options.radius && !(*options.radius > 0 && std::isfinite(*options.radius))) {
+    throw Error("--radius: expected a positive radius");
+  }
+
+  const CsvColumns read = read_csv(csv, {"frame", "particle", "x", "y", "z"},
+                                   {"ax", "ay", "az", "radius", "hole_contact"});
+  const Table& t = read.table;
+  const std::size_t rows = t.rows();
+  if (rows == 0) throw Error(csv.string() + ": no rows after the header");
+  const bool has_axis = t.has("ax") || t.has("ay") || t.has("az");
+  if (has_axis && !(t.has("ax") && t.has("ay") && t.has("az"))) {
+    throw Error(csv.string() + ": an axis needs all three columns ax, ay, az");
+  }
+  if (t.has("radius") && options.radius) {
+    throw Error(csv.string() + ": has a radius column; --radius is for tables without one");
+  }
+
+  std::vector<std::int64_t> frame_of(rows), particle_of(rows);
+  for (std::size_t r = 0; r < rows; ++r) {
+    frame_of[r] = label(t["frame"].values[r], csv, read.lines[r], "frame");
+    particle_of[r] = label(t["particle"].values[r], csv, read.lines[r], "particle");
+  }
+  const std::vector<std::int64_t> frames = sorted_unique(frame_of);
+  const std::vector<std::int64_t> particles = sorted_unique(particle_of);
+  const std::size_t n = particles.size();
+
+  Trajectories run;
+  RunHeader& h = run.header;
+  h.length_unit = stored_unit;
+  h.time_unit = "cycle";  // a table of scans knows their order, not their times
+  h.sample = options.sample;
+  h.id = particles;
+  h.has_axis = has_axis;
+  h.has_hole_contact = t.has("hole_contact");
+  if (options.voxel_size) h.voxel_size = *options.voxel_size;
+  if (options.box) {
+    Box b = *options.box;
+    b.lower = b.lower.cwiseProduct(scale);
+    b.edges = b.edges.cwiseProduct(scale);
+    h.box = b;
+  }
+  for (std::int64_t f : frames) {
+    Frame frame = Frame::unknown(h);
+    frame.step = f;
+    frame.time = static_cast<double>(f);
+    run.frames.push_back(std::move(frame));
+  }
+
+  std::vector<double> radius_sum(n, 0);
+  std::vector<std::size_t> radius_count(n, 0);
+  std::vector<std::size_t> seen_at(frames.size() * n, 0);  // line of the row, 0 = none
+  std::size_t axes_known = 0;
+  for (std::size_t r = 0; r < rows; ++r) {
+    const std::size_t line = read.lines[r];
+    const std::size_t ti = index_of(frames, frame_of[r]);
+    const std::size_t gi = index_of(particles, particle_of[r]);
+    std::size_t& first = seen_at[ti * n + gi];
+    if (first) {
+      throw Error(at(csv, line) + ": particle " + std::to_string(particle_of[r]) +
+                  " appears twice in frame " + std::to_string(frame_of[r]) + " (first at line " +
+                  std::to_string(first) + ")");
+    }
+    first = line;
+    Frame& frame = run.frames[ti];
+    const auto row = static_cast<Eigen::Index>(gi);
+    const Eigen::Vector3d x(t["x"].values[r], t["y"].values[r], t["z"].values[r]);
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(x[k])) {
+        throw Error(at(csv, line) + ", column '" + "xyz"[k] +
+                    "': expected a finite coordinate, found " +
+                    (std::isnan(x[k]) ? "nothing or nan" : "infinity"));
+      }
+    }
+    frame.position.row(row) = x.cwiseProduct(scale);
+    if (has_axis) {
+      const Eigen::Vector3d a(t["ax"].values[r], t["ay"].values[r], t["az"].values[r]);
+      const int unknown = a.array().isNaN().count();
+      if (unknown == 3) {
+        // The axis was not seen in this scan: keep NaN.
+      } else if (unknown > 0 || !a.allFinite()) {
+        throw Error(at(csv, line) + ": axis (ax,ay,az) must be three finite numbers or all empty");
+      } else {
+        // A direction in voxel space becomes a physical direction by the same scaling.
+        const Eigen::Vector3d p = a.cwiseProduct(scale);
+        if (p.norm() == 0) throw Error(at(csv, line) + ": axis (ax,ay,az) has zero length");
+        frame.axis.row(row) = p.normalized();
+        ++axes_known;
+      }
+    }
+    if (h.has_hole_contact) {
+      const double flag = t["hole_contact"].values[r];
+      if (flag != 0 && flag != 1) {
+        throw Error(at(csv, line) + ", column 'hole_contact': expected 0 or 1");
+      }
+      frame.hole_contact[gi] = static_cast<std::uint8_t>(flag);
+    }
+    if (t.has("radius")) {
+      const double rad = t["radius"].values[r];
+      if (!std::isnan(rad)) {
+        if (!(rad > 0) || !std::isfinite(rad)) {
+          throw Error(at(csv, line) + ", column 'radius': expected a positive radius");
+        }
+        radius_sum[gi] += rad;
+        ++radius_count[gi];
+      }
+    }
+  }
+
+  // A grain's radius is a property of the grain: average what the scans measured.
+  h.radius.assign(n, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t g = 0; g < n; ++g) {
+    if (radius_count[g])
+      h.radius[g] = radius_sum[g] / double(radius_count[g]) * scale.x();
+    else if (options.radius)
+      h.radius[g] = *options.radius * scale.x();
+  }
+
+  if (summary) {
+    summary->rows = rows;
+    summary->frames = frames.size();
+    summary->grains = n;
+    summary->missing = frames.size() * n - rows;
+    summary->axes_known = axes_known;
+    summary->length_unit = stored_unit;
+  }
+  return run;
+}
+
+}  // namespace granmem

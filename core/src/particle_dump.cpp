@@ -1,0 +1,121 @@
+#include "granmem/core/particle_dump.hpp"
+
+#include <charconv>
+#include <fstream>
+#include <string>
+
+#include "granmem/core/atomic_file.hpp"
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+namespace {
+
+void number(std::string& out, double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, r.ptr);
+}
+
+// The box of a frame: the container if the run has one, else the grains' bounding box.
+Box frame_box(const RunHeader& h, const Frame& f) {
+  if (h.box) return *h.box;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(0), hi = lo;
+  bool any = false;
+  for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
+    const Eigen::Vector3d x = f.position.row(i);
+    if (!x.allFinite()) continue;
+    lo = any ? lo.cwiseMin(x) : x;
+    hi = any ? hi.cwiseMax(x) : x;
+    any = true;
+  }
+  return Box{lo, hi - lo};
+}
+
+}  // namespace
+
+void write_particle_dump(const TrajectoryReader& run, const std::filesystem::path& out,
+                         DumpFormat format) {
+  const RunHeader& h = run.header();
+  AtomicFile file(out);
+  std::ofstream s(file.temp_path(), std::ios::binary);
+  if (!s) throw Error(out.string() + ": cannot open for writing");
+
+  std::string names = "id x y z radius";
+  std::string properties = "id:I:1:pos:R:3:radius:R:1";
+  if (h.has_axis) {
+    names += " ax ay az";
+    properties += ":axis:R:3";
+  }
+  if (h.has_orientation) {
+    names += " quatw quati quatj quatk";
+    properties += ":orientation:R:4";
+  }
+  if (h.has_hole_contact) {
+    names += " hole_contact";
+    properties += ":hole_contact:I:1";
+  }
+
+  std::string text;
+  for (std::size_t t = 0; t < run.frame_count(); ++t) {
+    const Frame f = run.read_frame(t);
+    std::size_t seen = 0;
+    for (Eigen::Index i = 0; i < f.position.rows(); ++i)
+      seen += f.position.row(i).allFinite();
+    const Box box = frame_box(h, f);
+    const Eigen::Vector3d hi = box.lower + box.edges;
+    if (format == DumpFormat::lammps) {
+      text += "ITEM: TIMESTEP\n" + std::to_string(f.step) + "\nITEM: NUMBER OF ATOMS\n" +
+              std::to_string(seen) + "\nITEM: BOX BOUNDS ff ff ff\n";
+      for (int k = 0; k < 3; ++k) {
+        number(text, box.lower[k]);
+        text += ' ';
+        number(text, hi[k]);
+        text += '\n';
+      }
+      text += "ITEM: ATOMS " + names + "\n";
+    } else {
+      text += std::to_string(seen) + "\nLattice=\"";
+      for (int k = 0; k < 3; ++k) {
+        for (int j = 0; j < 3; ++j) {
+          number(text, j == k ? box.edges[k] : 0.0);
+          text += (k == 2 && j == 2) ? "\" Origin=\"" : " ";
+        }
+      }
+      for (int k = 0; k < 3; ++k) {
+        number(text, box.lower[k]);
+        text += k == 2 ? "\"" : " ";
+      }
+      text += " Properties=" + properties + " Time=";
+      number(text, f.time);
+      text += " Step=" + std::to_string(f.step) + " Units=" + h.length_unit + " pbc=\"F F F\"\n";
+    }
+    for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
+      if (!f.position.row(i).allFinite()) continue;
+      text += std::to_string(h.id[std::size_t(i)]);
+      auto put = [&](double v) {
+        text += ' ';
+        number(text, v);
+      };
+      for (int k = 0; k < 3; ++k)
+        put(f.position(i, k));
+      put(h.radius[std::size_t(i)]);
+      if (h.has_axis) {
+        for (int k = 0; k < 3; ++k)
+          put(f.axis(i, k));
+      }
+      if (h.has_orientation) {
+        for (int k = 0; k < 4; ++k)
+          put(f.orientation(i, k));
+      }
+      if (h.has_hole_contact) text += f.hole_contact[std::size_t(i)] ? " 1" : " 0";
+      text += '\n';
+    }
+    s << text;
+    text.clear();
+  }
+  s.close();
+  if (!s) throw Error(out.string() + ": write failed (disk full?)");
+  file.commit();
+}
+
+}  // namespace granmem

@@ -1,0 +1,103 @@
+#include "granmem/core/statistics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+
+Summary summarize(const std::vector<double>& values) {
+  std::vector<double> v;
+  v.reserve(values.size());
+  for (double x : values) {
+    if (std::isfinite(x)) v.push_back(x);
+  }
+  Summary s;
+  s.count = v.size();
+  if (v.empty()) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    s.mean = s.median = s.mean_square = nan;
+    return s;
+  }
+  double sum = 0, sum_sq = 0;
+  for (double x : v) {
+    sum += x;
+    sum_sq += x * x;
+  }
+  s.mean = sum / double(v.size());
+  s.mean_square = sum_sq / double(v.size());
+  const std::size_t mid = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
+  s.median = v[mid];
+  if (v.size() % 2 == 0) {
+    s.median = 0.5 * (s.median + *std::max_element(v.begin(), v.begin() + std::ptrdiff_t(mid)));
+  }
+  return s;
+}
+
+Table probability_density(const std::vector<double>& values, const DensityOptions& options,
+                          const std::string& unit) {
+  const bool log = options.scale == BinScale::logarithmic;
+  if (options.bins == 0) throw Error("pdf: the number of bins must be at least 1");
+  std::size_t finite = 0;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (double x : values) {
+    if (!std::isfinite(x)) continue;
+    ++finite;
+    if (log && x <= 0) continue;
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  if (options.range) std::tie(lo, hi) = *options.range;
+  if (!(lo < hi) || !std::isfinite(lo) || !std::isfinite(hi)) {
+    if (finite > 0 && lo == hi && !options.range) {
+      // Every value equal: one bin around it keeps the table meaningful.
+      const double pad = lo == 0 ? 1 : std::abs(lo) * 1e-6;
+      hi = lo + pad;
+      lo = log ? lo / (1 + 1e-6) : lo - pad;
+    } else {
+      throw Error("pdf: empty value range (no finite values" +
+                  std::string(log ? " above zero" : "") + ", or a range with low >= high)");
+    }
+  }
+  if (log && lo <= 0) throw Error("pdf: logarithmic bins need a range above zero");
+
+  const std::size_t nb = options.bins;
+  std::vector<double> edges(nb + 1);
+  for (std::size_t i = 0; i <= nb; ++i) {
+    const double f = double(i) / double(nb);
+    edges[i] = log ? lo * std::pow(hi / lo, f) : lo + (hi - lo) * f;
+  }
+  edges.front() = lo;
+  edges.back() = hi;
+
+  std::vector<double> count(nb, 0);
+  for (double x : values) {
+    if (!std::isfinite(x) || x < lo || x > hi) continue;
+    // Bin by search over the edges, so that the bin agrees with the edges written out.
+    std::size_t b = std::size_t(std::upper_bound(edges.begin(), edges.end(), x) - edges.begin());
+    b = std::min(std::max<std::size_t>(b, 1), nb) - 1;
+    count[b] += 1;
+  }
+
+  Table t;
+  Column& c_lo = t.add("bin_lo", unit);
+  Column& c_hi = t.add("bin_hi", unit);
+  Column& c_mid = t.add("bin_center", unit);
+  Column& c_count = t.add("count", "", true);
+  Column& c_density = t.add("density", unit.empty() ? "" : "1/" + unit);
+  for (std::size_t i = 0; i < nb; ++i) {
+    c_lo.values.push_back(edges[i]);
+    c_hi.values.push_back(edges[i + 1]);
+    c_mid.values.push_back(log ? std::sqrt(edges[i] * edges[i + 1])
+                               : 0.5 * (edges[i] + edges[i + 1]));
+    c_count.values.push_back(count[i]);
+    c_density.values.push_back(finite ? count[i] / (double(finite) * (edges[i + 1] - edges[i]))
+                                      : 0);
+  }
+  return t;
+}
+
+}  // namespace granmem

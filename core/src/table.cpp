@@ -1,0 +1,188 @@
+#include "granmem/core/table.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <optional>
+
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+
+Column& Table::add(std::string name, std::string unit, bool integer) {
+  if (has(name)) throw Error("table already has a column '" + name + "'");
+  columns_.push_back(Column{std::move(name), std::move(unit), integer, {}});
+  return columns_.back();
+}
+
+bool Table::has(std::string_view name) const {
+  return std::any_of(columns_.begin(), columns_.end(),
+                     [&](const Column& c) { return c.name == name; });
+}
+
+const Column& Table::operator[](std::string_view name) const {
+  for (const Column& c : columns_) {
+    if (c.name == name) return c;
+  }
+  throw Error("table has no column '" + std::string(name) + "'");
+}
+
+Column& Table::operator[](std::string_view name) {
+  return const_cast<Column&>(static_cast<const Table&>(*this)[name]);
+}
+
+std::size_t Table::rows() const {
+  return columns_.empty() ? 0 : columns_.front().values.size();
+}
+
+namespace {
+
+void append_number(std::string& out, double v, bool integer) {
+  if (std::isnan(v)) {
+    out += "nan";
+    return;
+  }
+  char buf[32];
+  const auto [end, ec] = integer && std::abs(v) < 9.007199254740992e15
+                             ? std::to_chars(buf, buf + sizeof buf, static_cast<long long>(v))
+                             : std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
+  out.append(buf, end);
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t'))
+    s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) {
+    s.remove_suffix(1);
+  }
+  if (s.size() >= 2 && s.front() == '"' && s.back() == '"') s = s.substr(1, s.size() - 2);
+  return s;
+}
+
+// Splits one CSV line on commas (granmem's tables have no quoted commas).
+void split(std::string_view line, std::vector<std::string_view>& fields) {
+  fields.clear();
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', start);
+    fields.push_back(trim(line.substr(start, comma - start)));
+    if (comma == std::string_view::npos) return;
+    start = comma + 1;
+  }
+}
+
+std::optional<double> parse_number(std::string_view field) {
+  if (field.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const char* begin = field.data();
+  const char* last = field.data() + field.size();
+  if (*begin == '+') ++begin;
+  double v = 0;
+  const auto [end, ec] = std::from_chars(begin, last, v);
+  if (ec == std::errc::result_out_of_range) return std::nullopt;
+  if (ec != std::errc() || end != last) return std::nullopt;
+  return v;
+}
+
+}  // namespace
+
+void write_csv(const Table& table, const std::filesystem::path& path,
+               const std::vector<std::string>& comment) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error(path.string() + ": cannot open for writing");
+  std::string text;
+  for (const std::string& line : comment)
+    text += "# " + line + "\n";
+  const auto& cols = table.columns();
+  for (std::size_t c = 0; c < cols.size(); ++c)
+    text += (c ? "," : "") + cols[c].name;
+  text += '\n';
+  for (std::size_t r = 0; r < table.rows(); ++r) {
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      if (c) text += ',';
+      append_number(text, cols[c].values[r], cols[c].integer);
+    }
+    text += '\n';
+    if (text.size() > (1u << 20)) {
+      out << text;
+      text.clear();
+    }
+  }
+  out << text;
+  out.flush();
+  if (!out) throw Error(path.string() + ": write failed (disk full?)");
+}
+
+CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::string>& required,
+                    const std::vector<std::string>& optional) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open for reading");
+  const std::string where = path.string();
+
+  std::string line;
+  std::size_t line_no = 0;
+  std::vector<std::string_view> fields;
+  // Header: the first line that is not a comment or blank.
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    have_header = true;
+    break;
+  }
+  if (!have_header) throw Error(where + ": empty file, expected a CSV header line");
+  std::vector<std::string> header;
+  split(line, fields);
+  for (std::string_view f : fields) {
+    const std::string name(f);
+    if (!name.empty() && std::find(header.begin(), header.end(), name) != header.end()) {
+      throw Error(where + ": column '" + name + "' appears twice in the header");
+    }
+    header.push_back(name);
+  }
+
+  CsvColumns result;
+  std::vector<std::pair<std::size_t, Column*>> wanted;  // file field index, column
+  auto want = [&](const std::string& name, bool must) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) {
+      if (!must) return;
+      std::string have;
+      for (const std::string& h : header)
+        have += (have.empty() ? "" : ", ") + h;
+      throw Error(where + ": missing required column '" + name + "' (header has: " + have + ")");
+    }
+    wanted.emplace_back(static_cast<std::size_t>(it - header.begin()), &result.table.add(name));
+  };
+  for (const std::string& name : required)
+    want(name, true);
+  for (const std::string& name : optional)
+    want(name, false);
+
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    split(line, fields);
+    if (fields.size() != header.size()) {
+      throw Error(where + " line " + std::to_string(line_no) + ": " +
+                  std::to_string(fields.size()) + " fields, expected " +
+                  std::to_string(header.size()) + " as in the header");
+    }
+    for (auto& [index, column] : wanted) {
+      const std::optional<double> v = parse_number(fields[index]);
+      if (!v) {
+        throw Error(where + " line " + std::to_string(line_no) + ", column '" + column->name +
+                    "': expected a number, found '" + std::string(fields[index]) + "'");
+      }
+      column->values.push_back(*v);
+    }
+    result.lines.push_back(line_no);
+  }
+  if (in.bad()) throw Error(where + ": read error");
+  return result;
+}
+
+}  // namespace granmem

@@ -1,0 +1,65 @@
+#include "granmem/core/trajectories.hpp"
+
+#include <limits>
+
+#include <unordered_set>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem {
+
+Frame Frame::unknown(const RunHeader& header) {
+  const auto n = static_cast<Eigen::Index>(header.grain_count());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Frame frame;
+  frame.position = Vectors3::Constant(n, 3, nan);
+  if (header.has_axis) frame.axis = Vectors3::Constant(n, 3, nan);
+  if (header.has_orientation) frame.orientation = Quaternions::Constant(n, 4, nan);
+  if (header.has_hole_contact) frame.hole_contact.assign(header.grain_count(), 0);
+  return frame;
+}
+
+void check_frame(const RunHeader& header, const Frame& frame, const std::string& where) {
+  const auto n = static_cast<Eigen::Index>(header.grain_count());
+  auto expect = [&](bool ok, const std::string& what) {
+    if (!ok) throw Error(where + ": " + what);
+  };
+  expect(frame.position.rows() == n, "position has " + std::to_string(frame.position.rows()) +
+                                         " rows, expected " + std::to_string(n) + " grains");
+  expect(header.has_axis ? frame.axis.rows() == n : frame.axis.rows() == 0,
+         header.has_axis ? "axis must have one row per grain" : "axis given but run has none");
+  expect(header.has_orientation ? frame.orientation.rows() == n : frame.orientation.rows() == 0,
+         header.has_orientation ? "orientation must have one row per grain"
+                                : "orientation given but run has none");
+  expect(header.has_hole_contact ? frame.hole_contact.size() == header.grain_count()
+                                 : frame.hole_contact.empty(),
+         header.has_hole_contact ? "hole_contact must have one value per grain"
+                                 : "hole_contact given but run has none");
+}
+
+void check_header(const RunHeader& header, const std::string& where) {
+  auto expect = [&](bool ok, const std::string& what) {
+    if (!ok) throw Error(where + ": " + what);
+  };
+  expect(is_length_unit(header.length_unit),
+         "length unit '" + header.length_unit + "' is not one of m, cm, mm, um, voxel");
+  expect(header.radius.size() == header.grain_count(), "radius must have one value per grain");
+  std::unordered_set<std::int64_t> seen;
+  for (std::int64_t id : header.id)
+    expect(seen.insert(id).second, "grain id " + std::to_string(id) + " appears twice");
+  expect(header.sample == kSampleEndOfCycle || header.sample == kSampleFullCompression ||
+             header.sample == kSampleInCycle,
+         "sample '" + header.sample + "' is not one of end_of_cycle, full_compression, in_cycle");
+  if (header.box) {
+    expect(header.box->lower.allFinite() && header.box->edges.allFinite() &&
+               (header.box->edges.array() > 0).all(),
+           "box edges must be finite and positive");
+  }
+  if (header.voxel_size) {
+    expect(header.voxel_size->allFinite() && (header.voxel_size->array() > 0).all(),
+           "voxel size must be finite and positive");
+  }
+}
+
+}  // namespace granmem

@@ -1,0 +1,398 @@
+#include "granmem/core/trajectory_store.hpp"
+
+#include <cstdlib>
+
+#include "granmem/core/atomic_file.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/core/version.hpp"
+#include "granmem/core/xdmf.hpp"
+
+namespace granmem {
+namespace {
+
+constexpr const char* kGrains = "/particles/grains";
+
+// A time-dependent H5MD element: value[T,...], step[T], time[T], grown frame by frame.
+struct ElementWriter {
+  h5::Handle group, value, step, time;
+
+  template <class T>
+  static ElementWriter create(hid_t file, const std::string& path,
+                              const std::vector<hsize_t>& frame_dims, const std::string& unit,
+                              const std::string& time_unit) {
+    ElementWriter e;
+    e.group = h5::create_group(file, path);
+    e.value = h5::create_frames<T>(e.group.get(), "value", frame_dims, unit);
+    e.step = h5::create_frames<std::int64_t>(e.group.get(), "step", {}, "1");
+    e.time = h5::create_frames<double>(e.group.get(), "time", {}, time_unit);
+    return e;
+  }
+
+  template <class T>
+  void append(const T* data, const Frame& frame) const {
+    h5::append_frame(value.get(), data);
+    h5::append_frame(step.get(), &frame.step);
+    h5::append_frame(time.get(), &frame.time);
+  }
+};
+
+// "<group>/<key>" -> attribute `key` on group /parameters/<group>.
+void write_parameters(hid_t file, const std::map<std::string, std::string>& parameters) {
+  h5::Handle root = h5::create_group(file, "/parameters");
+  for (const auto& [key, value] : parameters) {
+    const std::size_t slash = key.rfind('/');
+    if (slash == std::string::npos) {
+      h5::write_attribute(root.get(), key, value);
+    } else {
+      h5::Handle g = h5::create_group(root.get(), key.substr(0, slash));
+      h5::write_attribute(g.get(), key.substr(slash + 1), value);
+    }
+  }
+}
+
+void read_parameters(const h5::File& file, const std::string& path, const std::string& prefix,
+                     std::map<std::string, std::string>& out) {
+  h5::Handle g = h5::open_group(file, path);
+  for (const std::string& name : h5::attribute_names(g.get())) {
+    if (auto v = h5::read_string_attribute(g.get(), name)) out[prefix + name] = *v;
+  }
+  for (const std::string& name : h5::member_names(g.get())) {
+    const h5::Handle member(H5Oopen(g.get(), name.c_str(), H5P_DEFAULT), H5Oclose);
+    if (H5Iget_type(member.get()) == H5I_GROUP) {
+      read_parameters(file, path + "/" + name, prefix + name + "/", out);
+    }
+  }
+}
+
+std::string default_author() {
+  const char* user = std::getenv("USER");
+  return user && *user ? user : "unknown";
+}
+
+}  // namespace
+
+struct TrajectoryWriter::Impl {
+  RunHeader header;
+  AtomicFile out;
+  h5::File file;
+  ElementWriter position, axis, orientation, hole_contact;
+  std::map<std::string, Observable> observables;
+  std::vector<std::int64_t> steps;
+  std::vector<double> times;
+
+  Impl(const std::filesystem::path& path, RunHeader h)
+      : header(std::move(h)), out(path), file(h5::File::create(out.temp_path())) {}
+};
+
+TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader header) {
+  check_header(header, path.string());
+  impl_ = std::make_unique<Impl>(path, std::move(header));
+  const RunHeader& h = impl_->header;
+  const hid_t f = impl_->file.id();
+  const hsize_t n = h.grain_count();
+
+  h5::Handle h5md = h5::create_group(f, "/h5md");
+  h5::write_attribute(h5md.get(), "version", std::vector<int>{1, 1});
+  h5::Handle author = h5::create_group(h5md.get(), "author");
+  h5::write_attribute(author.get(), "name", h.author.empty() ? default_author() : h.author);
+  h5::Handle creator = h5::create_group(h5md.get(), "creator");
+  h5::write_attribute(creator.get(), "name", h.creator_name);
+  h5::write_attribute(creator.get(), "version",
+                      h.creator_version.empty() ? std::string(kVersion) : h.creator_version);
+
+  h5::Handle grains = h5::create_group(f, kGrains);
+  h5::write(grains.get(), "id", h.id.data(), {n}, "1");
+  h5::write(grains.get(), "radius", h.radius.data(), {n}, h.length_unit);
+  h5::Handle box = h5::create_group(grains.get(), "box");
+  h5::write_attribute(box.get(), "dimension", std::vector<int>{3});
+  h5::write_attribute(box.get(), "boundary", std::vector<std::string>{"none", "none", "none"});
+  if (h.box) {
+    h5::write(box.get(), "edges", h.box->edges.data(), {3}, h.length_unit);
+    h5::write(box.get(), "offset", h.box->lower.data(), {3}, h.length_unit);
+  }
+
+  impl_->position = ElementWriter::create<double>(f, std::string(kGrains) + "/position", {n, 3},
+                                                  h.length_unit, h.time_unit);
+  h5::write_attribute(impl_->position.group.get(), "sample", h.sample);
+  if (h.has_axis) {
+    impl_->axis =
+        ElementWriter::create<double>(f, std::string(kGrains) + "/axis", {n, 3}, "1", h.time_unit);
+  }
+  if (h.has_orientation) {
+    impl_->orientation = ElementWriter::create<double>(f, std::string(kGrains) + "/orientation",
+                                                       {n, 4}, "1", h.time_unit);
+  }
+  if (h.has_hole_contact) {
+    impl_->hole_contact = ElementWriter::create<std::uint8_t>(
+        f, std::string(kGrains) + "/hole_contact", {n}, "1", h.time_unit);
+  }
+
+  write_parameters(f, h.parameters);
+  if (h.voxel_size) {
+    h5::Handle params = h5::create_group(f, "/parameters");
+    h5::write(params.get(), "voxel_size", h.voxel_size->data(), {3}, h.length_unit);
+  }
+}
+
+TrajectoryWriter::~TrajectoryWriter() = default;
+
+void TrajectoryWriter::append(const Frame& frame) {
+  Impl& w = *impl_;
+  check_frame(w.header, frame,
+              w.out.target().string() + " frame " + std::to_string(w.steps.size()));
+  w.position.append(frame.position.data(), frame);
+  if (w.header.has_axis) w.axis.append(frame.axis.data(), frame);
+  if (w.header.has_orientation) w.orientation.append(frame.orientation.data(), frame);
+  if (w.header.has_hole_contact) w.hole_contact.append(frame.hole_contact.data(), frame);
+  w.steps.push_back(frame.step);
+  w.times.push_back(frame.time);
+}
+
+void TrajectoryWriter::set_observable(const std::string& name, Observable observable) {
+  if (observable.step.size() != observable.value.size() ||
+      observable.time.size() != observable.value.size()) {
+    throw Error("observable " + name + ": value, step and time must have equal lengths");
+  }
+  impl_->observables[name] = std::move(observable);
+}
+
+std::size_t TrajectoryWriter::frame_count() const {
+  return impl_->steps.size();
+}
+
+void TrajectoryWriter::commit() {
+  Impl& w = *impl_;
+  for (const auto& [name, obs] : w.observables) {
+    h5::Handle g = h5::create_group(w.file.id(), "/observables/" + name);
+    const std::vector<hsize_t> dims{obs.value.size()};
+    h5::write(g.get(), "value", obs.value.data(), dims, obs.unit);
+    h5::write(g.get(), "step", obs.step.data(), dims, "1");
+    h5::write(g.get(), "time", obs.time.data(), dims, w.header.time_unit);
+  }
+  w.position = {};
+  w.axis = {};
+  w.orientation = {};
+  w.hole_contact = {};
+  w.file.close();
+  w.out.commit();
+  write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
+}
+
+struct TrajectoryReader::Impl {
+  h5::File file;
+  std::string group;
+  RunHeader header;
+  std::vector<std::int64_t> steps;
+  std::vector<double> times;
+  std::map<std::string, Observable> observables;
+  h5::Handle position, axis, orientation, hole_contact;
+};
+
+TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& r = *impl_;
+  r.file = h5::File::open(path);
+  const std::string& name = r.file.name();
+  const hid_t f = r.file.id();
+  if (!h5::exists(f, "/h5md")) {
+    throw Error(name + ": not a granmem/H5MD trajectory file (no /h5md group)");
+  }
+  // granmem writes /particles/grains; another H5MD producer's single particle group works too.
+  r.group = kGrains;
+  if (!h5::exists(f, r.group) && h5::exists(f, "/particles")) {
+    h5::Handle particles = h5::open_group(r.file, "/particles");
+    const std::vector<std::string> groups = h5::member_names(particles.get());
+    if (groups.size() == 1) r.group = "/particles/" + groups.front();
+  }
+  const std::string pos = r.group + "/position";
+  r.position = h5::open_dataset(r.file, pos + "/value");
+  const std::vector<hsize_t> dims = h5::shape(r.position.get());
+  if (dims.size() != 3 || dims[2] != 3) {
+    throw Error(name + ": dataset " + pos + "/value has shape " + h5::shape_text(dims) +
+                ", expected [frames,grains,3]");
+  }
+  const hsize_t t_count = dims[0], n = dims[1];
+  r.steps = h5::read<std::int64_t>(r.file, pos + "/step");
+  r.times = h5::read<double>(r.file, pos + "/time");
+  if (r.steps.size() != t_count || r.times.size() != t_count) {
+    throw Error(name + ": " + pos + "/step and /time must have one entry per frame (" +
+                std::to_string(t_count) + ")");
+  }
+
+  RunHeader& h = r.header;
+  h.length_unit = h5::read_string_attribute(r.position.get(), "unit").value_or("");
+  if (!is_length_unit(h.length_unit)) {
+    throw Error(name + ": dataset " + pos + "/value has unit '" + h.length_unit +
+                "', expected one of m, cm, mm, um, voxel");
+  }
+  {
+    h5::Handle time = h5::open_dataset(r.file, pos + "/time");
+    h.time_unit = h5::read_string_attribute(time.get(), "unit").value_or("1");
+    h5::Handle group = h5::open_group(r.file, pos);
+    h.sample = h5::read_string_attribute(group.get(), "sample").value_or(kSampleEndOfCycle);
+  }
+
+  const std::string id_path = r.group + "/id";
+  if (h5::exists(f, id_path)) {
+    h.id = h5::read<std::int64_t>(r.file, id_path);
+    if (h.id.size() != n) {
+      throw Error(name + ": dataset " + id_path + " must hold one id per grain (" +
+                  std::to_string(n) + ")");
+    }
+  } else {
+    for (hsize_t i = 0; i < n; ++i)
+      h.id.push_back(static_cast<std::int64_t>(i));
+  }
+  const std::string radius_path = r.group + "/radius";
+  h.radius.assign(n, std::numeric_limits<double>::quiet_NaN());
+  if (h5::exists(f, radius_path)) {
+    h.radius = h5::read<double>(r.file, radius_path);
+    if (h.radius.size() != n) {
+      throw Error(name + ": dataset " + radius_path + " must hold one radius per grain (" +
+                  std::to_string(n) + ")");
+    }
+  }
+  const std::string edges_path = r.group + "/box/edges";
+  if (h5::exists(f, edges_path)) {
+    const std::vector<double> edges = h5::read<double>(r.file, edges_path);
+    if (edges.size() != 3) throw Error(name + ": dataset " + edges_path + " must hold 3 values");
+    Box box;
+    box.edges = Eigen::Vector3d(edges[0], edges[1], edges[2]);
+    const std::string offset_path = r.group + "/box/offset";
+    if (h5::exists(f, offset_path)) {
+      const std::vector<double> lower = h5::read<double>(r.file, offset_path);
+      if (lower.size() != 3) throw Error(name + ": dataset " + offset_path + " must hold 3 values");
+      box.lower = Eigen::Vector3d(lower[0], lower[1], lower[2]);
+    }
+    h.box = box;
+  }
+
+  // Optional per-frame elements must match the positions frame for frame.
+  auto open_element = [&](const std::string& element, std::vector<hsize_t> frame_dims,
+                          h5::Handle& out) {
+    const std::string path = r.group + "/" + element + "/value";
+    if (!h5::exists(f, path)) return false;
+    out = h5::open_dataset(r.file, path);
+    frame_dims.insert(frame_dims.begin(), t_count);
+    if (h5::shape(out.get()) != frame_dims) {
+      throw Error(name + ": dataset " + path + " has shape " +
+                  h5::shape_text(h5::shape(out.get())) + ", expected " +
+                  h5::shape_text(frame_dims));
+    }
+    return true;
+  };
+  h.has_axis = open_element("axis", {n, 3}, r.axis);
+  h.has_orientation = open_element("orientation", {n, 4}, r.orientation);
+  h.has_hole_contact = open_element("hole_contact", {n}, r.hole_contact);
+
+  if (h5::exists(f, "/h5md/creator")) {
+    h5::Handle creator = h5::open_group(r.file, "/h5md/creator");
+    h.creator_name = h5::read_string_attribute(creator.get(), "name").value_or("");
+    h.creator_version = h5::read_string_attribute(creator.get(), "version").value_or("");
+  }
+  if (h5::exists(f, "/h5md/author")) {
+    h5::Handle author = h5::open_group(r.file, "/h5md/author");
+    h.author = h5::read_string_attribute(author.get(), "name").value_or("");
+  }
+  if (h5::exists(f, "/parameters")) {
+    read_parameters(r.file, "/parameters", "", h.parameters);
+    if (h5::exists(f, "/parameters/voxel_size")) {
+      const std::vector<double> v = h5::read<double>(r.file, "/parameters/voxel_size");
+      if (v.size() != 3) throw Error(name + ": dataset /parameters/voxel_size must hold 3 values");
+      h.voxel_size = Eigen::Vector3d(v[0], v[1], v[2]);
+    }
+  }
+  check_header(h, name);
+
+  if (h5::exists(f, "/observables")) {
+    h5::Handle obs = h5::open_group(r.file, "/observables");
+    for (const std::string& o : h5::member_names(obs.get())) {
+      const std::string base = "/observables/" + o;
+      Observable ob;
+      ob.value = h5::read<double>(r.file, base + "/value");
+      ob.step = h5::read<std::int64_t>(r.file, base + "/step");
+      ob.time = h5::read<double>(r.file, base + "/time");
+      h5::Handle value = h5::open_dataset(r.file, base + "/value");
+      ob.unit = h5::read_string_attribute(value.get(), "unit").value_or("1");
+      if (ob.step.size() != ob.value.size() || ob.time.size() != ob.value.size()) {
+        throw Error(name + ": observable " + base + " needs value, step and time of equal length");
+      }
+      r.observables[o] = std::move(ob);
+    }
+  }
+}
+
+TrajectoryReader::~TrajectoryReader() = default;
+TrajectoryReader::TrajectoryReader(TrajectoryReader&&) noexcept = default;
+
+const RunHeader& TrajectoryReader::header() const {
+  return impl_->header;
+}
+std::size_t TrajectoryReader::frame_count() const {
+  return impl_->steps.size();
+}
+const std::vector<std::int64_t>& TrajectoryReader::steps() const {
+  return impl_->steps;
+}
+const std::vector<double>& TrajectoryReader::times() const {
+  return impl_->times;
+}
+const std::map<std::string, Observable>& TrajectoryReader::observables() const {
+  return impl_->observables;
+}
+const std::string& TrajectoryReader::file_name() const {
+  return impl_->file.name();
+}
+const h5::File& TrajectoryReader::file() const {
+  return impl_->file;
+}
+const std::string& TrajectoryReader::particles_group() const {
+  return impl_->group;
+}
+
+Frame TrajectoryReader::read_frame(std::size_t t) const {
+  const Impl& r = *impl_;
+  if (t >= r.steps.size()) {
+    throw Error(r.file.name() + ": no frame " + std::to_string(t) + " (file has " +
+                std::to_string(r.steps.size()) + ")");
+  }
+  Frame frame = Frame::unknown(r.header);
+  frame.step = r.steps[t];
+  frame.time = r.times[t];
+  const std::string& g = r.group;
+  h5::read_frame(r.file, r.position.get(), g + "/position/value", t, frame.position.data());
+  if (r.header.has_axis) {
+    h5::read_frame(r.file, r.axis.get(), g + "/axis/value", t, frame.axis.data());
+  }
+  if (r.header.has_orientation) {
+    h5::read_frame(r.file, r.orientation.get(), g + "/orientation/value", t,
+                   frame.orientation.data());
+  }
+  if (r.header.has_hole_contact) {
+    h5::read_frame(r.file, r.hole_contact.get(), g + "/hole_contact/value", t,
+                   frame.hole_contact.data());
+  }
+  return frame;
+}
+
+void write_trajectories(const std::filesystem::path& path, const Trajectories& run) {
+  TrajectoryWriter writer(path, run.header);
+  for (const Frame& frame : run.frames)
+    writer.append(frame);
+  for (const auto& [name, obs] : run.observables)
+    writer.set_observable(name, obs);
+  writer.commit();
+}
+
+Trajectories read_trajectories(const std::filesystem::path& path) {
+  TrajectoryReader reader(path);
+  Trajectories run;
+  run.header = reader.header();
+  run.observables = reader.observables();
+  for (std::size_t t = 0; t < reader.frame_count(); ++t)
+    run.frames.push_back(reader.read_frame(t));
+  return run;
+}
+
+}  // namespace granmem

@@ -1,3 +1,4 @@
+#include <charconv>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
@@ -24,16 +25,22 @@ std::vector<std::string> split_list(const std::string& text) {
 // A few rows of the per-frame table, so the user sees the run's story at a glance.
 void print_per_frame(const Table& p, const std::string& unit) {
   const std::size_t rows = p.rows();
-  std::cout << "  frame       n    mean_dr [" << unit << "]  median_dr    mean_theta_axis [deg]\n";
+  std::cout << std::setw(7) << "frame" << std::setw(8) << "n" << std::setw(14) << "mean_dr"
+            << std::setw(14) << "median_dr" << std::setw(14) << "mean_theta"
+            << "\n"
+            << std::setw(29) << "[" + unit + "]" << std::setw(14) << "[" + unit + "]"
+            << std::setw(14) << "[deg]"
+            << "\n";
   for (std::size_t r = 0; r < rows; ++r) {
     if (rows > 12 && r == 5) {
-      std::cout << "  ...\n";
+      std::cout << std::setw(7) << "..."
+                << "\n";
       r = rows - 5;
     }
-    std::cout << "  " << std::setw(5) << p["frame"].values[r] << "  " << std::setw(6)
-              << p["n"].values[r] << "  " << std::setw(12) << std::setprecision(5)
-              << p["mean_dr"].values[r] << "  " << std::setw(12) << p["median_dr"].values[r] << "  "
-              << std::setw(10) << p["mean_theta_axis_deg"].values[r] << "\n";
+    std::cout << std::setprecision(5) << std::setw(7) << p["frame"].values[r] << std::setw(8)
+              << p["n"].values[r] << std::setw(14) << p["mean_dr"].values[r] << std::setw(14)
+              << p["median_dr"].values[r] << std::setw(14) << p["mean_theta_axis_deg"].values[r]
+              << "\n";
   }
 }
 
@@ -69,7 +76,16 @@ void add_analyze(CLI::App& app) {
   cmd->add_option("--pdf-frames", args->pdf_frames,
                   "FIRST:LAST frames (labels) pooled into the pdfs; default all");
   cmd->add_option("--pdf-bins", args->pdf_bins, "number of bins")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            // CLI::PositiveNumber would say "not in range 0.000000 to <309 digits>".
+            unsigned long long bins = 0;
+            const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), bins);
+            const bool ok = ec == std::errc() && end == text.data() + text.size() && bins > 0;
+            return ok ? std::string()
+                      : "expected a whole number of bins, at least 1, got '" + text + "'";
+          },
+          "POSITIVE"))
       ->capture_default_str();
   cmd->add_option("--pdf-scale", args->pdf_scale, "linear or log bins")
       ->check(CLI::IsMember({"linear", "log"}))
@@ -104,6 +120,8 @@ void add_analyze(CLI::App& app) {
     const auto written =
         write_motion_analysis(a, args->out, {"granmem analyze " + args->run}, used);
 
+    for (const std::string& note : a.notes)
+      std::cerr << "granmem: note: " << note << "\n";
     const bool radius_known =
         std::any_of(h.radius.begin(), h.radius.end(), [](double r) { return std::isfinite(r); });
     if ((h.has_axis || h.has_orientation) && !radius_known) {

@@ -10,9 +10,15 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", granmem::kVersion);
   app.set_config("--config", "", "TOML file of options, one [section] per command");
   app.require_subcommand(1);
-  app.fallthrough();  // --config may follow the command name
+  app.fallthrough();                                        // --config may follow the command name
+  app.allow_config_extras(CLI::config_extras_mode::error);  // a mistyped key is an error
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    return std::string("granmem: error: ") + e.what() + " (see granmem --help)\n";
+    std::string what = e.what();
+    const std::string unknown_key = "INI was not able to parse ";  // CLI11's words for a typo
+    if (what.rfind(unknown_key, 0) == 0) {
+      what = "--config: no option " + what.substr(unknown_key.size()) + " ([command] option)";
+    }
+    return "granmem: error: " + what + " (see granmem --help)\n";
   });
   granmem::app::add_import(app);
   granmem::app::add_info(app);

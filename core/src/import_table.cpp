@@ -145,8 +145,9 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
       } else {
         // A direction in voxel space becomes a physical direction by the same scaling.
         const Eigen::Vector3d p = a.cwiseProduct(scale);
-        if (p.norm() == 0) throw Error(at(csv, line) + ": axis (ax,ay,az) has zero length");
-        frame.axis.row(row) = p.normalized();
+        // Any length: the stable norm neither overflows (1e200) nor underflows (1e-200).
+        if (p.stableNorm() == 0) throw Error(at(csv, line) + ": axis (ax,ay,az) has zero length");
+        frame.axis.row(row) = p.stableNormalized();
         ++axes_known;
       }
     }

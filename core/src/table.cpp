@@ -127,6 +127,7 @@ CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::st
   bool have_header = false;
   while (std::getline(in, line)) {
     ++line_no;
+    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // Excel's BOM
     const std::string_view t = trim(line);
     if (t.empty() || t.front() == '#') continue;
     have_header = true;

@@ -139,6 +139,7 @@ TrajectoryWriter::~TrajectoryWriter() = default;
 
 void TrajectoryWriter::append(const Frame& frame) {
   Impl& w = *impl_;
+  if (w.file.id() < 0) throw Error(w.out.target().string() + ": cannot append after commit()");
   check_frame(w.header, frame,
               w.out.target().string() + " frame " + std::to_string(w.steps.size()));
   w.position.append(frame.position.data(), frame);
@@ -154,6 +155,10 @@ void TrajectoryWriter::set_observable(const std::string& name, Observable observ
       observable.time.size() != observable.value.size()) {
     throw Error("observable " + name + ": value, step and time must have equal lengths");
   }
+  if (impl_->file.id() < 0) {
+    throw Error(impl_->out.target().string() + ": cannot set observable " + name +
+                " after commit()");
+  }
   impl_->observables[name] = std::move(observable);
 }
 
@@ -163,6 +168,7 @@ std::size_t TrajectoryWriter::frame_count() const {
 
 void TrajectoryWriter::commit() {
   Impl& w = *impl_;
+  if (w.file.id() < 0) throw Error(w.out.target().string() + ": already committed");
   for (const auto& [name, obs] : w.observables) {
     h5::Handle g = h5::create_group(w.file.id(), "/observables/" + name);
     const std::vector<hsize_t> dims{obs.value.size()};
@@ -175,8 +181,10 @@ void TrajectoryWriter::commit() {
   w.orientation = {};
   w.hole_contact = {};
   w.file.close();
+  // Sidecar first: if it cannot be written, an existing run of this name stays as it was.
+  AtomicFile sidecar = write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
   w.out.commit();
-  write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
+  sidecar.commit();
 }
 
 struct TrajectoryReader::Impl {

@@ -53,13 +53,36 @@ std::string attribute(const char* name, const char* type, const std::string& dat
          "\" Center=\"Node\">\n" + data + "</Attribute>\n";
 }
 
+std::string xml_escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
-void write_xdmf(const std::filesystem::path& h5_path, const std::string& group,
-                const RunHeader& header, const std::vector<std::int64_t>& steps,
-                const std::vector<double>& times) {
+AtomicFile write_xdmf(const std::filesystem::path& h5_path, const std::string& group,
+                      const RunHeader& header, const std::vector<std::int64_t>& steps,
+                      const std::vector<double>& times) {
   // The sidecar sits beside the file and refers to it by name, so the pair can be moved.
-  const std::string ref = h5_path.filename().string() + ":" + group;
+  const std::string ref = xml_escaped(h5_path.filename().string() + ":" + group);
   const std::size_t n = header.grain_count(), frames = steps.size();
   std::ostringstream x;
   x.precision(17);
@@ -91,7 +114,7 @@ void write_xdmf(const std::filesystem::path& h5_path, const std::string& group,
     f << x.str();
     if (!f) throw Error(out.target().string() + ": cannot write the XDMF sidecar");
   }
-  out.commit();
+  return out;
 }
 
 }  // namespace granmem

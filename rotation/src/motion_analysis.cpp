@@ -127,6 +127,10 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   for (std::size_t r = 0; r < d.rows(); ++r) {
     if (frame.values[r] >= double(first) && frame.values[r] <= double(last)) window.push_back(r);
   }
+  if (window.empty() && !options.pdf_frames) {
+    a.notes.push_back("no pdfs: no grain was followed from one frame to the next");
+    return a;
+  }
   if (window.empty()) {
     throw Error("--pdf-frames " + std::to_string(first) + ":" + std::to_string(last) +
                 ": no displacements in these frames (the run's frames are " +
@@ -148,8 +152,12 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     for (std::size_t r : window)
       values.push_back(c.values[r]);
     if (std::none_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
-      throw Error("pdf of '" + q + "': no measured values in frames " + std::to_string(first) +
-                  " to " + std::to_string(last));
+      const std::string why = "no measured values of " + q + " in frames " + std::to_string(first) +
+                              " to " + std::to_string(last);
+      // A pdf asked for must be made; a default one is skipped with a note.
+      if (!options.pdf_quantities.empty()) throw Error("pdf of '" + q + "': " + why);
+      a.notes.push_back("no pdf of " + q + ": " + why);
+      continue;
     }
     a.pdfs[q] = probability_density(values, options.density, c.unit);
   }

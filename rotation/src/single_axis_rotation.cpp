@@ -7,7 +7,7 @@
 namespace granmem {
 
 double single_axis_angle(const Eigen::Vector3d& a1, const Eigen::Vector3d& a2) {
-  const double n1 = a1.norm(), n2 = a2.norm();
+  const double n1 = a1.stableNorm(), n2 = a2.stableNorm();
   if (!(n1 > 0) || !(n2 > 0) || !std::isfinite(n1) || !std::isfinite(n2)) {
     return std::numeric_limits<double>::quiet_NaN();
   }

@@ -37,6 +37,7 @@ struct MotionAnalysis {
   Table per_frame;
   std::map<std::string, Table> pdfs;  // quantity -> bin_lo, bin_hi, bin_center, count, density
   std::string length_unit;
+  std::vector<std::string> notes;  // what was left out and why, for the user
   std::pair<std::int64_t, std::int64_t> pdf_frames{0, 0};
 };
 

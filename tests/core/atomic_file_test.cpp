@@ -1,0 +1,126 @@
+#include "granmem/core/atomic_file.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "granmem/core/error.hpp"
+#include "temp_dir.hpp"
+
+namespace granmem {
+namespace {
+
+namespace fs = std::filesystem;
+
+class AtomicFileTest : public granmem::testing::TempDirTest {
+ protected:
+  std::vector<std::string> listing() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir_))
+      names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+};
+
+TEST_F(AtomicFileTest, CommitRenamesTheTemporaryFileIntoPlace) {
+  const fs::path target = path("out.txt");
+  AtomicFile f(target);
+  EXPECT_EQ(f.target(), target);
+  EXPECT_EQ(f.temp_path().parent_path(), dir_);  // same folder: the rename is atomic
+  EXPECT_NE(f.temp_path(), target);
+  EXPECT_EQ(f.temp_path().filename().string().rfind(".out.txt.tmp-", 0), 0u);
+  write_text(f.temp_path(), "hello\n");
+  EXPECT_FALSE(fs::exists(target));  // nothing under the real name before commit
+  f.commit();
+  EXPECT_EQ(read_text(target), "hello\n");
+  EXPECT_FALSE(fs::exists(f.temp_path()));
+  EXPECT_EQ(listing(), (std::vector<std::string>{"out.txt"}));
+  f.commit();  // a second commit does nothing
+  EXPECT_EQ(read_text(target), "hello\n");
+}
+
+TEST_F(AtomicFileTest, CommitReplacesAnExistingFile) {
+  const fs::path target = path("out.txt");
+  write_text(target, "old");
+  {
+    AtomicFile f(target);
+    write_text(f.temp_path(), "new contents");
+    f.commit();
+  }
+  EXPECT_EQ(read_text(target), "new contents");
+  EXPECT_EQ(listing(), (std::vector<std::string>{"out.txt"}));
+}
+
+TEST_F(AtomicFileTest, WithoutCommitTheTempGoesAndTheTargetIsUntouched) {
+  const fs::path target = path("data.bin");
+  const std::string original("original\0\x01\xff bytes\n", 19);
+  write_text(target, original);
+  fs::path temp;
+  {
+    AtomicFile f(target);
+    temp = f.temp_path();
+    write_text(temp, "half-written junk");
+    ASSERT_TRUE(fs::exists(temp));
+  }
+  EXPECT_FALSE(fs::exists(temp));
+  EXPECT_EQ(read_text(target), original);
+  EXPECT_EQ(fs::file_size(target), original.size());
+  EXPECT_EQ(listing(), (std::vector<std::string>{"data.bin"}));
+
+  // Also when the scope is left by an exception.
+  try {
+    AtomicFile f(target);
+    write_text(f.temp_path(), "junk");
+    throw Error("failure while writing");
+  } catch (const Error&) {
+  }
+  EXPECT_EQ(read_text(target), original);
+  EXPECT_EQ(listing(), (std::vector<std::string>{"data.bin"}));
+}
+
+TEST_F(AtomicFileTest, WithoutCommitNoFileAppears) {
+  { AtomicFile f(path("new.txt")); }  // no temp written at all
+  {
+    AtomicFile f(path("new.txt"));
+    write_text(f.temp_path(), "x");
+  }
+  EXPECT_TRUE(listing().empty());
+}
+
+TEST_F(AtomicFileTest, MovedFromObjectNeitherRemovesNorCommits) {
+  const fs::path target = path("moved.txt");
+  AtomicFile a(target);
+  write_text(a.temp_path(), "payload");
+  AtomicFile b(std::move(a));
+  EXPECT_TRUE(fs::exists(b.temp_path()));
+  b.commit();
+  EXPECT_EQ(read_text(target), "payload");
+}
+
+TEST_F(AtomicFileTest, DistinctTempNamesForTheSameTarget) {
+  AtomicFile a(path("x.txt"));
+  AtomicFile b(path("x.txt"));
+  EXPECT_NE(a.temp_path(), b.temp_path());
+}
+
+TEST_F(AtomicFileTest, MissingFolderOrFolderTargetIsAnError) {
+  try {
+    AtomicFile f(path("missing") / "out.txt");
+    FAIL() << "expected granmem::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  fs::create_directory(path("sub"));
+  EXPECT_THROW(AtomicFile f(path("sub")), Error);
+  EXPECT_EQ(listing(), (std::vector<std::string>{"sub"}));
+}
+
+}  // namespace
+}  // namespace granmem

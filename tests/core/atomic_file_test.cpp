@@ -17,16 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class AtomicFileTest : public granmem::testing::TempDirTest {
- protected:
-  std::vector<std::string> listing() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir_))
-      names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-};
+class AtomicFileTest : public granmem::testing::TempDirTest {};
 
 TEST_F(AtomicFileTest, CommitRenamesTheTemporaryFileIntoPlace) {
   const fs::path target = path("out.txt");

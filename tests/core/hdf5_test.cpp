@@ -12,21 +12,14 @@
 #include "granmem/core/error.hpp"
 #include "temp_dir.hpp"
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
 
-class Hdf5 : public granmem::testing::TempDirTest {};
+using testing::error_message;
 
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected granmem::Error";
-  return "";
-}
+class Hdf5 : public granmem::testing::TempDirTest {};
 
 TEST_F(Hdf5, TableRoundTripKeepsOrderUnitsTypesAndBits) {
   Table t;

@@ -12,25 +12,16 @@
 
 #include "granmem/core/error.hpp"
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
 
+using testing::pdf_integral;
+using testing::pdf_total_count;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-double integral(const Table& t) {
-  double sum = 0;
-  for (std::size_t i = 0; i < t.rows(); ++i)
-    sum += t["density"].values[i] * (t["bin_hi"].values[i] - t["bin_lo"].values[i]);
-  return sum;
-}
-
-double total_count(const Table& t) {
-  double sum = 0;
-  for (double c : t["count"].values)
-    sum += c;
-  return sum;
-}
 
 TEST(Summarize, OddCount) {
   const Summary s = summarize({3, 1, 2});
@@ -121,7 +112,7 @@ TEST(ProbabilityDensity, LinearBinsKnownCounts) {
   const std::vector<double> d = t["density"].values;
   EXPECT_DOUBLE_EQ(d[0], 2.0 / 18.0);
   EXPECT_DOUBLE_EQ(d[3], 3.0 / 18.0);
-  EXPECT_DOUBLE_EQ(integral(t), 1.0);
+  EXPECT_DOUBLE_EQ(pdf_integral(t), 1.0);
   EXPECT_EQ(probability_density(v, o)["density"].unit, "");
 }
 
@@ -136,8 +127,8 @@ TEST(ProbabilityDensity, DefaultRangeIntegratesToOne) {
   o.bins = 37;
   const Table t = probability_density(v, o);
   ASSERT_EQ(t.rows(), 37u);
-  EXPECT_EQ(total_count(t), 5000.0);
-  EXPECT_NEAR(integral(t), 1.0, 1e-12);
+  EXPECT_EQ(pdf_total_count(t), 5000.0);
+  EXPECT_NEAR(pdf_integral(t), 1.0, 1e-12);
   const double width = t["bin_hi"].values[0] - t["bin_lo"].values[0];
   for (std::size_t i = 0; i < t.rows(); ++i) {
     const double w = t["bin_hi"].values[i] - t["bin_lo"].values[i];
@@ -158,7 +149,7 @@ TEST(ProbabilityDensity, ExplicitRangeCountsOutsideValuesInTheNormalisationOnly)
   EXPECT_EQ(t["bin_lo"].values, (std::vector<double>{0, 1, 2, 3}));
   EXPECT_EQ(t["count"].values, (std::vector<double>{1, 1, 1, 0}));
   EXPECT_EQ(t["density"].values, (std::vector<double>{0.2, 0.2, 0.2, 0}));
-  EXPECT_DOUBLE_EQ(integral(t), 0.6);  // the fraction of values inside the range
+  EXPECT_DOUBLE_EQ(pdf_integral(t), 0.6);  // the fraction of values inside the range
 }
 
 TEST(ProbabilityDensity, LogarithmicBins) {
@@ -190,11 +181,11 @@ TEST(ProbabilityDensity, LogarithmicBins) {
   EXPECT_NEAR(t["density"].values[0], 2.0 / (8 * 9), 1e-15);
   EXPECT_NEAR(t["density"].values[1], 2.0 / (8 * 90), 1e-15);
   EXPECT_NEAR(t["density"].values[2], 2.0 / (8 * 900), 1e-15);
-  EXPECT_NEAR(integral(t), 0.75, 1e-12);  // 6 of 8 finite values are in a bin
+  EXPECT_NEAR(pdf_integral(t), 0.75, 1e-12);  // 6 of 8 finite values are in a bin
 
   // Without the non-positive values the default range holds everything.
   const Table all = probability_density({1, 2, 20, 50, 500, 1000}, o);
-  EXPECT_NEAR(integral(all), 1.0, 1e-12);
+  EXPECT_NEAR(pdf_integral(all), 1.0, 1e-12);
 }
 
 TEST(ProbabilityDensity, AllValuesEqualGiveOneBinAroundThem) {
@@ -205,7 +196,7 @@ TEST(ProbabilityDensity, AllValuesEqualGiveOneBinAroundThem) {
   EXPECT_LT(t["bin_lo"].values[0], 3.0);
   EXPECT_GT(t["bin_hi"].values[0], 3.0);
   EXPECT_EQ(t["count"].values[0], 3.0);
-  EXPECT_NEAR(integral(t), 1.0, 1e-9);
+  EXPECT_NEAR(pdf_integral(t), 1.0, 1e-9);
 }
 
 TEST(ProbabilityDensity, InvalidRangeIsAnError) {

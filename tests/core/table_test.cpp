@@ -13,8 +13,12 @@
 #include "granmem/core/error.hpp"
 #include "temp_dir.hpp"
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
+
+using testing::error_message;
 
 using Limits = std::numeric_limits<double>;
 
@@ -25,18 +29,6 @@ class TableCsv : public granmem::testing::TempDirTest {};
   if (std::isnan(expected) && std::isnan(actual)) return ::testing::AssertionSuccess();
   if (std::memcmp(&expected, &actual, sizeof(double)) == 0) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "expected " << expected << " got " << actual;
-}
-
-// The message of the granmem::Error that `f` throws (a test failure if it throws none).
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected granmem::Error";
-  return "";
 }
 
 TEST(Table, ColumnsKeepOrderAndReferencesStayValid) {

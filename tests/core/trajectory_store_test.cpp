@@ -22,8 +22,12 @@
 #include "granmem/core/xdmf.hpp"
 #include "temp_dir.hpp"
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
+
+using testing::error_message;
 
 namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -175,17 +179,6 @@ void expect_same_run(const Trajectories& a, const Trajectories& b) {
   expect_same_observables(a.observables, b.observables);
 }
 
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected granmem::Error";
-  return "";
-}
-
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t p = text.find(what); p != std::string::npos; p = text.find(what, p + 1))
@@ -195,14 +188,6 @@ std::size_t count(const std::string& text, const std::string& what) {
 
 class TrajectoryStore : public granmem::testing::TempDirTest {
  protected:
-  std::vector<std::string> listing() const {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir_))
-      names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
-
   // A good store to damage in the error tests.
   fs::path good_store(const std::string& name = "good.h5") {
     const fs::path p = path(name);

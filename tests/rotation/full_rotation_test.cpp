@@ -7,15 +7,14 @@
 #include <limits>
 #include <random>
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using testing::random_unit_vector;
 
-Eigen::Vector3d random_unit_vector(std::mt19937& rng) {
-  std::normal_distribution<double> gauss;
-  return Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
-}
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Uniform on the rotation group: a normalised Gaussian 4-vector.
 Eigen::Quaterniond random_orientation(std::mt19937& rng) {

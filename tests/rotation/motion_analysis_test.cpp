@@ -16,8 +16,15 @@
 #include "granmem/core/hdf5.hpp"
 #include "temp_dir.hpp"
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
+
+using testing::error_message;
+using testing::pdf_integral;
+using testing::pdf_total_count;
+using testing::same_number;
 
 namespace fs = std::filesystem;
 
@@ -98,26 +105,6 @@ std::vector<std::string> column_names(const Table& t) {
   return names;
 }
 
-double total_count(const Table& pdf) {
-  double n = 0;
-  for (double c : pdf["count"].values)
-    n += c;
-  return n;
-}
-
-double integral(const Table& pdf) {
-  double sum = 0;
-  for (std::size_t b = 0; b < pdf.rows(); ++b) {
-    sum += pdf["density"].values[b] * (pdf["bin_hi"].values[b] - pdf["bin_lo"].values[b]);
-  }
-  return sum;
-}
-
-// Equal as stored numbers: same value bit for bit, or both NaN.
-bool same_number(double a, double b) {
-  return (std::isnan(a) && std::isnan(b)) || a == b;
-}
-
 void expect_same_values(const Table& read, const Table& expected, const std::string& what) {
   ASSERT_EQ(column_names(read), column_names(expected)) << what;
   ASSERT_EQ(read.rows(), expected.rows()) << what;
@@ -129,18 +116,6 @@ void expect_same_values(const Table& read, const Table& expected, const std::str
           << ", expected " << c.values[i];
     }
   }
-}
-
-// The message of the Error that `f` throws; fails the test if it throws none.
-template <class F>
-std::string error_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected granmem::Error";
-  return "";
 }
 
 class MotionAnalysisTest : public testing::TempDirTest {
@@ -256,8 +231,8 @@ TEST_F(MotionAnalysisTest, DefaultPdfsPoolEveryFrameAndIntegrateToOne) {
   for (const auto& [q, pdf] : a.pdfs) {
     quantities.insert(q);
     EXPECT_EQ(pdf.rows(), 50u) << q;
-    EXPECT_EQ(total_count(pdf), 5.0) << q;  // all five displacements
-    EXPECT_NEAR(integral(pdf), 1.0, 1e-12) << q;
+    EXPECT_EQ(pdf_total_count(pdf), 5.0) << q;  // all five displacements
+    EXPECT_NEAR(pdf_integral(pdf), 1.0, 1e-12) << q;
   }
   EXPECT_EQ(quantities,
             (std::set<std::string>{"dr", "theta_axis_deg", "rot_disp", "theta_full_deg"}));
@@ -296,8 +271,8 @@ TEST_F(MotionAnalysisTest, PdfOfManyGrainsIntegratesToOne) {
   EXPECT_EQ(a.per_frame["n"].values, (std::vector<double>{58, 58, 58}));
   EXPECT_EQ(a.pdfs.size(), 3u);  // dr, theta_axis_deg, rot_disp: no orientations
   for (const auto& [q, pdf] : a.pdfs) {
-    EXPECT_EQ(total_count(pdf), 174.0) << q;
-    EXPECT_NEAR(integral(pdf), 1.0, 1e-12) << q;
+    EXPECT_EQ(pdf_total_count(pdf), 174.0) << q;
+    EXPECT_NEAR(pdf_integral(pdf), 1.0, 1e-12) << q;
   }
   // The line angle never exceeds 90 degrees.
   EXPECT_LE(a.pdfs.at("theta_axis_deg")["bin_hi"].values.back(), 90.0);
@@ -309,8 +284,8 @@ TEST_F(MotionAnalysisTest, PdfOfManyGrainsIntegratesToOne) {
   options.pdf_quantities = {"dr"};
   options.density.range = std::make_pair(0.0, 0.5 * (sorted[86] + sorted[87]));
   const MotionAnalysis half = analyze_motion(TrajectoryReader(path("run.h5")), options);
-  EXPECT_EQ(total_count(half.pdfs.at("dr")), 87.0);
-  EXPECT_NEAR(integral(half.pdfs.at("dr")), 0.5, 1e-12);
+  EXPECT_EQ(pdf_total_count(half.pdfs.at("dr")), 87.0);
+  EXPECT_NEAR(pdf_integral(half.pdfs.at("dr")), 0.5, 1e-12);
 }
 
 TEST_F(MotionAnalysisTest, PdfWindowSelectsFramesByLabel) {
@@ -359,7 +334,7 @@ TEST_F(MotionAnalysisTest, PdfRequestsThatCannotBeMetAreErrors) {
     EXPECT_THROW(analyze_motion(run, options), Error) << not_a_quantity;
   }
   options.pdf_quantities = {"dz"};  // any displacement column is a quantity
-  EXPECT_EQ(total_count(analyze_motion(run, options).pdfs.at("dz")), 5.0);
+  EXPECT_EQ(pdf_total_count(analyze_motion(run, options).pdfs.at("dz")), 5.0);
 }
 
 TEST_F(MotionAnalysisTest, RunWithOneFrameHasNoDisplacements) {

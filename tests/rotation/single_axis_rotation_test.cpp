@@ -8,15 +8,14 @@
 #include <limits>
 #include <random>
 
+#include "checks.hpp"
+
 namespace granmem {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+using testing::random_unit_vector;
 
-Eigen::Vector3d random_unit_vector(std::mt19937& rng) {
-  std::normal_distribution<double> gauss;
-  return Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
-}
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The angle between the lines along unit a and R a, R the rotation by phi about unit u:
 // Rodrigues' formula gives a . R a = cos(phi) + (1 - cos(phi)) (u . a)^2 for the angle

@@ -2,11 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace granmem::testing {
 
@@ -29,6 +31,16 @@ class TempDirTest : public ::testing::Test {
     std::filesystem::remove_all(dir_, ec);
   }
   std::filesystem::path path(const std::string& name) const { return dir_ / name; }
+
+  // The names in the folder, sorted: what a run left behind, temporary files included.
+  std::vector<std::string> listing() const {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir_)) {
+      names.push_back(e.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
 
   static void write_text(const std::filesystem::path& p, const std::string& text) {
     std::ofstream(p, std::ios::binary) << text;

@@ -107,6 +107,7 @@ BENCHMARK(BM_WriteStore)->Args({20000, 11})->Unit(benchmark::kMillisecond)->UseR
 BENCHMARK(BM_AnalyzeMotion)
     ->Args({2000, 11})
     ->Args({20000, 11})
+    ->Args({20000, 101})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -84,7 +84,8 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     append(dr.values, m.dr);
     append(theta_axis.values, theta_deg);
     append(rot_disp.values, rot_len);
-    if (full) append(theta_full->values, in_degrees(m.theta_full));
+    const std::vector<double> full_deg = in_degrees(m.theta_full);  // empty without orientations
+    if (full) append(theta_full->values, full_deg);
 
     const Summary s_dr = summarize(m.dr), s_theta = summarize(theta_deg),
                   s_rot = summarize(rot_len);
@@ -99,7 +100,7 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     p_n_rot.values.push_back(double(s_theta.count));
     p_msd.values.push_back(s_dr.mean_square);
     if (full) {
-      const Summary s_full = summarize(in_degrees(m.theta_full));
+      const Summary s_full = summarize(full_deg);
       p_mean_full->values.push_back(s_full.mean);
       p_median_full->values.push_back(s_full.median);
     }

@@ -12,6 +12,7 @@ void add_import(CLI::App& app);
 void add_info(CLI::App& app);
 void add_analyze(CLI::App& app);
 void add_export(CLI::App& app);
+void add_simulate(CLI::App& app);
 
 // The options of a subcommand as actually used (given or default), "<command>/<option>"
 // -> value, for the output's /parameters.

@@ -24,10 +24,11 @@ int main(int argc, char** argv) {
   granmem::app::add_info(app);
   granmem::app::add_analyze(app);
   granmem::app::add_export(app);
+  granmem::app::add_simulate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return app.exit(e);  // a CLI::RuntimeError (e.g. an interrupted run) prints nothing
   } catch (const std::exception& e) {
     std::cerr << "granmem: error: " << e.what() << "\n";
     return 1;

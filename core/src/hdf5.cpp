@@ -132,6 +132,20 @@ File File::open(const std::filesystem::path& path) {
   return f;
 }
 
+File File::open_for_writing(const std::filesystem::path& path) {
+  File f = open(path);  // the checks and messages of a read
+  f.handle_ = Handle();
+  f.handle_ = Handle(H5Fopen(f.name_.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+  if (f.handle_.get() < 0) throw Error(f.name_ + ": cannot open HDF5 file for writing");
+  return f;
+}
+
+void File::flush() {
+  if (H5Fflush(handle_.get(), H5F_SCOPE_GLOBAL) < 0) {
+    throw Error(name_ + ": writing the HDF5 file failed (disk full?)");
+  }
+}
+
 void File::close() {
   if (handle_.get() < 0) return;
   const herr_t flushed = H5Fflush(handle_.get(), H5F_SCOPE_GLOBAL);
@@ -153,6 +167,11 @@ bool exists(hid_t loc, const std::string& path) {
     pos = next;
   }
   return true;
+}
+
+void remove(hid_t loc, const std::string& path) {
+  if (exists(loc, path))
+    check(H5Ldelete(loc, path.c_str(), H5P_DEFAULT), "HDF5: cannot remove " + path);
 }
 
 Handle create_group(hid_t loc, const std::string& path) {
@@ -269,6 +288,13 @@ void append_frame(hid_t dataset, const T* data) {
   if (elements(count) == 0) return;
   check(H5Dwrite(dataset, Type<T>::memory(), mem_space.get(), file_space.get(), H5P_DEFAULT, data),
         "HDF5: cannot write frame");
+}
+
+void truncate_frames(hid_t dataset, hsize_t frames) {
+  std::vector<hsize_t> dims = shape(dataset);
+  if (dims.empty() || frames > dims[0]) throw Error("HDF5: cannot keep more frames than there are");
+  dims[0] = frames;
+  check(H5Dset_extent(dataset, dims.data()), "HDF5: cannot shrink dataset");
 }
 
 template <class T>

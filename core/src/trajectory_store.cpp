@@ -29,6 +29,18 @@ struct ElementWriter {
     return e;
   }
 
+  // An element of a file written before, cut to its first `frames` frames.
+  static ElementWriter open(const h5::File& file, const std::string& path, hsize_t frames) {
+    ElementWriter e;
+    e.group = h5::open_group(file, path);
+    e.value = h5::open_dataset(file, path + "/value");
+    e.step = h5::open_dataset(file, path + "/step");
+    e.time = h5::open_dataset(file, path + "/time");
+    for (const h5::Handle* d : {&e.value, &e.step, &e.time})
+      h5::truncate_frames(d->get(), frames);
+    return e;
+  }
+
   template <class T>
   void append(const T* data, const Frame& frame) const {
     h5::append_frame(value.get(), data);
@@ -83,6 +95,23 @@ struct TrajectoryWriter::Impl {
 
   Impl(const std::filesystem::path& path, RunHeader h)
       : header(std::move(h)), out(path), file(h5::File::create(out.temp_path())) {}
+  Impl(RunHeader h, h5::File opened, AtomicFile temp)
+      : header(std::move(h)), out(std::move(temp)), file(std::move(opened)) {}
+
+  void check_open(const std::string& what) const {
+    if (file.id() < 0) throw Error(out.target().string() + ": cannot " + what + " after commit()");
+  }
+  // Observables are written whole, replacing what an earlier publish() wrote.
+  void write_observables() {
+    h5::remove(file.id(), "/observables");
+    for (const auto& [name, obs] : observables) {
+      h5::Handle g = h5::create_group(file.id(), "/observables/" + name);
+      const std::vector<hsize_t> dims{obs.value.size()};
+      h5::write(g.get(), "value", obs.value.data(), dims, obs.unit);
+      h5::write(g.get(), "step", obs.step.data(), dims, "1");
+      h5::write(g.get(), "time", obs.time.data(), dims, header.time_unit);
+    }
+  }
 };
 
 TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader header) {
@@ -139,7 +168,7 @@ TrajectoryWriter::~TrajectoryWriter() = default;
 
 void TrajectoryWriter::append(const Frame& frame) {
   Impl& w = *impl_;
-  if (w.file.id() < 0) throw Error(w.out.target().string() + ": cannot append after commit()");
+  w.check_open("append");
   check_frame(w.header, frame,
               w.out.target().string() + " frame " + std::to_string(w.steps.size()));
   w.position.append(frame.position.data(), frame);
@@ -155,10 +184,7 @@ void TrajectoryWriter::set_observable(const std::string& name, Observable observ
       observable.time.size() != observable.value.size()) {
     throw Error("observable " + name + ": value, step and time must have equal lengths");
   }
-  if (impl_->file.id() < 0) {
-    throw Error(impl_->out.target().string() + ": cannot set observable " + name +
-                " after commit()");
-  }
+  impl_->check_open("set observable " + name);
   impl_->observables[name] = std::move(observable);
 }
 
@@ -166,16 +192,26 @@ std::size_t TrajectoryWriter::frame_count() const {
   return impl_->steps.size();
 }
 
+void TrajectoryWriter::publish() {
+  Impl& w = *impl_;
+  w.check_open("publish");
+  w.write_observables();
+  w.file.flush();
+  // A copy of the flushed file goes into place; the original stays open for writing.
+  AtomicFile copy(w.out.target());
+  std::error_code ec;
+  std::filesystem::copy_file(w.out.temp_path(), copy.temp_path(),
+                             std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw Error(w.out.target().string() + ": cannot publish: " + ec.message());
+  AtomicFile sidecar = write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
+  copy.commit();
+  sidecar.commit();
+}
+
 void TrajectoryWriter::commit() {
   Impl& w = *impl_;
-  if (w.file.id() < 0) throw Error(w.out.target().string() + ": already committed");
-  for (const auto& [name, obs] : w.observables) {
-    h5::Handle g = h5::create_group(w.file.id(), "/observables/" + name);
-    const std::vector<hsize_t> dims{obs.value.size()};
-    h5::write(g.get(), "value", obs.value.data(), dims, obs.unit);
-    h5::write(g.get(), "step", obs.step.data(), dims, "1");
-    h5::write(g.get(), "time", obs.time.data(), dims, w.header.time_unit);
-  }
+  w.check_open("commit");
+  w.write_observables();
   w.position = {};
   w.axis = {};
   w.orientation = {};
@@ -185,6 +221,70 @@ void TrajectoryWriter::commit() {
   AtomicFile sidecar = write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
   w.out.commit();
   sidecar.commit();
+}
+
+TrajectoryWriter TrajectoryWriter::resume(const std::filesystem::path& path,
+                                          std::size_t keep_frames) {
+  RunHeader header;
+  std::map<std::string, Observable> observables;
+  std::vector<std::int64_t> steps;
+  std::vector<double> times;
+  {
+    const TrajectoryReader before(path);
+    if (keep_frames > before.frame_count()) {
+      throw Error(path.string() + ": has " + std::to_string(before.frame_count()) +
+                  " frames, cannot continue after frame " + std::to_string(keep_frames));
+    }
+    if (before.particles_group() != kGrains) {
+      throw Error(path.string() + ": only granmem's own runs can be continued");
+    }
+    header = before.header();
+    steps.assign(before.steps().begin(), before.steps().begin() + std::ptrdiff_t(keep_frames));
+    times.assign(before.times().begin(), before.times().begin() + std::ptrdiff_t(keep_frames));
+    // Observables of steps after the last kept frame belong to the part that is redone.
+    const std::int64_t last = keep_frames ? steps.back() : std::numeric_limits<std::int64_t>::min();
+    for (const auto& [name, obs] : before.observables()) {
+      Observable kept;
+      kept.unit = obs.unit;
+      for (std::size_t k = 0; k < obs.value.size(); ++k) {
+        if (obs.step[k] > last) continue;
+        kept.value.push_back(obs.value[k]);
+        kept.step.push_back(obs.step[k]);
+        kept.time.push_back(obs.time[k]);
+      }
+      observables[name] = std::move(kept);
+    }
+  }
+  AtomicFile temp(path);
+  std::error_code ec;
+  std::filesystem::copy_file(path, temp.temp_path(), ec);
+  if (ec) throw Error(path.string() + ": cannot copy to continue it: " + ec.message());
+  h5::File file = h5::File::open_for_writing(temp.temp_path());
+
+  TrajectoryWriter writer;
+  writer.impl_ = std::make_unique<Impl>(std::move(header), std::move(file), std::move(temp));
+  Impl& w = *writer.impl_;
+  const std::string g = kGrains;
+  w.position = ElementWriter::open(w.file, g + "/position", keep_frames);
+  if (w.header.has_axis) w.axis = ElementWriter::open(w.file, g + "/axis", keep_frames);
+  if (w.header.has_orientation) {
+    w.orientation = ElementWriter::open(w.file, g + "/orientation", keep_frames);
+  }
+  if (w.header.has_hole_contact) {
+    w.hole_contact = ElementWriter::open(w.file, g + "/hole_contact", keep_frames);
+  }
+  w.observables = std::move(observables);
+  w.steps = std::move(steps);
+  w.times = std::move(times);
+  return writer;
+}
+
+TrajectoryWriter::TrajectoryWriter(TrajectoryWriter&&) noexcept = default;
+const std::map<std::string, Observable>& TrajectoryWriter::observables() const {
+  return impl_->observables;
+}
+const RunHeader& TrajectoryWriter::header() const {
+  return impl_->header;
 }
 
 struct TrajectoryReader::Impl {

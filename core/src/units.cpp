@@ -80,4 +80,54 @@ double convert_length(double value, std::string_view from, std::string_view to) 
   return value * (metres_per(from) / metres_per(to));
 }
 
+namespace {
+
+struct SiUnit {
+  Dimension dimension;
+  std::string_view name;
+  double si;
+};
+constexpr SiUnit kSiUnits[] = {
+    {Dimension::length, "m", 1.0},
+    {Dimension::length, "cm", 1e-2},
+    {Dimension::length, "mm", 1e-3},
+    {Dimension::length, "um", 1e-6},
+    {Dimension::time, "s", 1.0},
+    {Dimension::time, "ms", 1e-3},
+    {Dimension::time, "us", 1e-6},
+    {Dimension::mass, "kg", 1.0},
+    {Dimension::mass, "g", 1e-3},
+    {Dimension::density, "kg/m^3", 1.0},
+    {Dimension::density, "g/cm^3", 1e3},
+    {Dimension::stiffness, "N/m", 1.0},
+    {Dimension::stiffness, "kg/s^2", 1.0},
+    {Dimension::stiffness, "g/s^2", 1e-3},
+    {Dimension::stiffness, "dyn/cm", 1e-3},
+    {Dimension::acceleration, "m/s^2", 1.0},
+    {Dimension::acceleration, "cm/s^2", 1e-2},
+    {Dimension::velocity, "m/s", 1.0},
+    {Dimension::velocity, "cm/s", 1e-2},
+    {Dimension::velocity, "mm/s", 1e-3},
+    {Dimension::energy, "J", 1.0},
+    {Dimension::energy, "erg", 1e-7},
+};
+
+}  // namespace
+
+double parse_si(std::string_view text, Dimension dimension, std::string_view default_unit,
+                std::string_view what) {
+  Quantity q = parse_quantity(text, what);
+  if (q.unit.empty()) q.unit = std::string(default_unit);
+  std::string accepted;
+  for (const SiUnit& u : kSiUnits) {
+    if (u.dimension != dimension) continue;
+    if (u.name == q.unit) return q.value * u.si;
+    accepted += (accepted.empty() ? "" : ", ") + std::string(u.name);
+  }
+  throw Error(
+      std::string(what) + " '" + std::string(text) + "': " +
+      (q.unit.empty() ? std::string("needs a unit") : "unit '" + q.unit + "' is not one of") +
+      " (" + accepted + ")");
+}
+
 }  // namespace granmem

@@ -36,8 +36,10 @@ class Handle {
 // An open file and its name, which every message about it carries.
 class File {
  public:
-  static File create(const std::filesystem::path& path);  // new file, truncating
-  static File open(const std::filesystem::path& path);    // read-only; Error if not HDF5
+  static File create(const std::filesystem::path& path);            // new file, truncating
+  static File open(const std::filesystem::path& path);              // read-only; Error if not HDF5
+  static File open_for_writing(const std::filesystem::path& path);  // an existing file
+  void flush();  // everything written so far on disk: the file is complete as it stands
   hid_t id() const { return handle_.get(); }
   const std::string& name() const { return name_; }
   void close();  // flushes; throws Error if the data could not be written
@@ -48,6 +50,7 @@ class File {
 };
 
 bool exists(hid_t loc, const std::string& path);
+void remove(hid_t loc, const std::string& path);          // unlinks a group or dataset if there
 Handle create_group(hid_t loc, const std::string& path);  // intermediate groups too
 Handle open_group(const File& file, const std::string& path);
 Handle open_dataset(const File& file, const std::string& path);
@@ -68,6 +71,8 @@ Handle create_frames(hid_t loc, const std::string& name, const std::vector<hsize
                      const std::string& unit);
 template <class T>
 void append_frame(hid_t dataset, const T* data);
+// Keeps the first `frames` frames of a [T, ...] dataset made by create_frames.
+void truncate_frames(hid_t dataset, hsize_t frames);
 // Reads frame `t` of a [T, ...] dataset into `data` (size of one frame).
 template <class T>
 void read_frame(const File& file, hid_t dataset, const std::string& path, hsize_t t, T* data);

@@ -25,19 +25,30 @@ namespace granmem {
 // Writes a run frame by frame into a temporary file; commit() renames it into place and
 // writes the XDMF sidecar (<name>.xmf) that lets ParaView open it. Dropped without
 // commit(), it leaves nothing behind and any existing file of that name untouched.
+// For long runs, publish() puts a complete copy of what is written so far in place and
+// goes on, and resume() continues a run published or committed before.
 class TrajectoryWriter {
  public:
   TrajectoryWriter(const std::filesystem::path& path, RunHeader header);
+  // Continues the run in the file at `path` after its first `keep_frames` frames (later
+  // frames, and observables of later steps, are dropped). The file itself is untouched
+  // until the next publish() or commit().
+  static TrajectoryWriter resume(const std::filesystem::path& path, std::size_t keep_frames);
   ~TrajectoryWriter();
+  TrajectoryWriter(TrajectoryWriter&&) noexcept;
   TrajectoryWriter(const TrajectoryWriter&) = delete;
   TrajectoryWriter& operator=(const TrajectoryWriter&) = delete;
 
   void append(const Frame& frame);
   void set_observable(const std::string& name, Observable observable);
+  const std::map<std::string, Observable>& observables() const;
+  const RunHeader& header() const;
   std::size_t frame_count() const;
+  void publish();
   void commit();
 
  private:
+  TrajectoryWriter() = default;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

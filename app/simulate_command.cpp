@@ -1,0 +1,264 @@
+#include <omp.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include "commands.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/sim/cyclic_protocol.hpp"
+#include "granmem/sim/deposit.hpp"
+
+namespace granmem::app {
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void request_stop(int) {
+  g_stop.store(true);
+}
+
+// Every option as text, as given or defaulted: it is parsed with its unit below, stored
+// in the checkpoint, and read back from it on --resume.
+struct SimulateArgs {
+  std::map<std::string, std::string> value;  // option name -> text
+};
+
+struct OptionSpec {
+  const char* name;
+  const char* default_value;
+  const char* help;
+};
+// The defaults are the paper's table and protocol.
+const OptionSpec kOptions[] = {
+    {"grains", "2000", "number of grains"},
+    {"cycles", "10", "compression cycles"},
+    {"amplitude", "1%", "wall amplitude A: a length (0.15cm) or a fraction of the box (1%)"},
+    {"drive", "asymmetric", "asymmetric (0 -> A -> 0) or symmetric (0 -> A/2 -> -A/2 -> 0)"},
+    {"wall-motion", "cosine", "cosine (smooth) or linear"},
+    {"period", "auto", "cycle period (25ms...), or auto: the inertial number below"},
+    {"inertial-number", "1e-3", "quasi-static limit for the automatic period"},
+    {"box", "15cm", "side of the square box"},
+    {"diameter", "0.5cm", "grain diameter"},
+    {"polydispersity", "0", "radii uniform in r(1 +- p)"},
+    {"density", "1.18g/cm^3", "grain density"},
+    {"lid-mass", "1kg", "mass of the free lid (0: no lid)"},
+    {"k-n", "4e6g/s^2", "normal spring constant"},
+    {"restitution-n", "0.2", "normal restitution coefficient"},
+    {"restitution-t", "0.5", "tangential restitution coefficient"},
+    {"kt-over-kn", "0.714285714285714", "tangential over normal spring constant (5/7)"},
+    {"mu-s", "0.2", "sliding friction between grains"},
+    {"mu-r", "0.01", "rolling friction"},
+    {"mu-t", "0.001", "twisting friction"},
+    {"beta", "0.5", "shape parameter of rolling and twisting"},
+    {"wall-mu-s", "same", "sliding friction on walls and lid (same: as between grains)"},
+    {"wall-mu-r", "same", "rolling friction on walls and lid"},
+    {"wall-mu-t", "same", "twisting friction on walls and lid"},
+    {"dt", "25us", "time step"},
+    {"skin", "0.05cm", "neighbour-list skin"},
+    {"gravity", "9.81m/s^2", "gravity"},
+    {"seed", "1", "seed of the deposition"},
+    {"settled-energy", "1e-13J", "kinetic energy per grain below which a packing is settled"},
+    {"settling-damping", "5", "drag rate while settling, 1/s"},
+    {"full-compression", "false", "also write frames at full compression"},
+    {"track", "", "grain ids sampled inside cycles, comma list"},
+    {"samples-per-cycle", "0", "in-cycle samples of the tracked grains"},
+    {"checkpoint-every", "0", "cycles between checkpoints (0: at the end and on Ctrl-C)"},
+    {"checkpoint", "", "checkpoint file (default <out>.checkpoint.h5)"},
+    {"out", "run.h5", "end-of-cycle trajectory store"},
+};
+
+double number(const std::map<std::string, std::string>& v, const std::string& name) {
+  const Quantity q = parse_quantity(v.at(name), "--" + name);
+  if (!q.unit.empty()) throw Error("--" + name + " '" + v.at(name) + "': expected a plain number");
+  return q.value;
+}
+double si(const std::map<std::string, std::string>& v, const std::string& name, Dimension d,
+          const char* default_unit = "") {
+  return parse_si(v.at(name), d, default_unit, "--" + name);
+}
+std::int64_t whole(const std::map<std::string, std::string>& v, const std::string& name) {
+  const double x = number(v, name);
+  if (x != std::floor(x) || x < 0) throw Error("--" + name + ": expected a whole number >= 0");
+  return std::int64_t(x);
+}
+
+PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
+  PhysicsOptions p;
+  p.contact.k_n = si(v, "k-n", Dimension::stiffness);
+  p.contact.restitution_n = number(v, "restitution-n");
+  p.contact.restitution_t = number(v, "restitution-t");
+  p.contact.k_t_over_k_n = number(v, "kt-over-kn");
+  p.contact.mu_s = number(v, "mu-s");
+  p.contact.mu_r = number(v, "mu-r");
+  p.contact.mu_t = number(v, "mu-t");
+  p.contact.beta = number(v, "beta");
+  auto wall = [&](const char* name, double grain) {
+    return v.at(name) == "same" ? grain : number(v, name);
+  };
+  p.wall = {wall("wall-mu-s", p.contact.mu_s), wall("wall-mu-r", p.contact.mu_r),
+            wall("wall-mu-t", p.contact.mu_t)};
+  p.density = si(v, "density", Dimension::density);
+  p.gravity = si(v, "gravity", Dimension::acceleration);
+  p.dt = si(v, "dt", Dimension::time);
+  p.skin = si(v, "skin", Dimension::length);
+  return p;
+}
+
+std::string duration_text(double seconds) {
+  const auto s = std::llround(seconds);
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%lldh%02lldm", s / 3600, (s % 3600) / 60);
+  else
+    std::snprintf(buf, sizeof buf, "%lldm%02llds", s / 60, s % 60);
+  return buf;
+}
+
+}  // namespace
+
+void add_simulate(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  auto threads = std::make_shared<int>(0);
+  auto resume = std::make_shared<std::string>();
+  CLI::App* cmd = app.add_subcommand(
+      "simulate", "Deposit grains in the box under a lid and compress them cyclically (DEM)");
+  std::map<std::string, CLI::Option*> given;
+  for (const OptionSpec& o : kOptions) {
+    args->value[o.name] = o.default_value;
+    given[o.name] = cmd->add_option(std::string("--") + o.name, args->value[o.name], o.help)
+                        ->capture_default_str();
+  }
+  cmd->add_option("--threads", *threads, "OpenMP threads (default: all cores)");
+  cmd->add_option("--resume", *resume, "continue the run of this checkpoint")
+      ->check(CLI::ExistingFile);
+
+  cmd->callback([args, threads, resume, given] {
+    if (*threads > 0) omp_set_num_threads(*threads);
+    std::signal(SIGINT, request_stop);
+    std::map<std::string, std::string> v = args->value;
+    ProtocolState state;
+    std::optional<Simulation> sim;
+    if (!resume->empty()) {
+      sim.emplace(read_checkpoint(*resume, &state));
+      // The run goes on with the settings it started with; more cycles may be asked for.
+      for (const auto& [key, value] : state.settings)
+        v[key] = value;
+      for (const char* may_change : {"cycles", "checkpoint-every"}) {
+        if (given.at(may_change)->count()) v[may_change] = args->value.at(may_change);
+      }
+      std::cerr << "resuming " << *resume << " after cycle " << state.cycles_done
+                << (state.step_in_cycle ? " (+" + std::to_string(state.step_in_cycle) + " steps)"
+                                        : std::string())
+                << "\n";
+    }
+    const PhysicsOptions physics = physics_from(v);
+    const double box = si(v, "box", Dimension::length);
+    const double radius = 0.5 * si(v, "diameter", Dimension::length);
+    const std::string out = v.at("out");
+    std::string checkpoint = v.at("checkpoint");
+    if (checkpoint.empty()) {
+      const std::filesystem::path o(out);
+      checkpoint = (o.parent_path() / (o.stem().string() + ".checkpoint.h5")).string();
+      v["checkpoint"] = checkpoint;
+    }
+
+    if (!sim) {
+      DepositOptions d;
+      d.grains = whole(v, "grains");
+      d.radius = radius;
+      d.polydispersity = number(v, "polydispersity");
+      d.box_side = box;
+      d.lid_mass = si(v, "lid-mass", Dimension::mass);
+      d.seed = std::uint64_t(whole(v, "seed"));
+      d.settled_energy = si(v, "settled-energy", Dimension::energy);
+      d.settling_damping = number(v, "settling-damping");
+      physics.validate("simulate", d.radius * (1 - d.polydispersity));
+      std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
+      DepositSummary s;
+      double last = -1;
+      sim.emplace(deposit(d, physics, &s, [&](const std::string& stage, double t, double e) {
+        if (t - last >= 0.1 || t < last) {
+          std::cerr << "  " << stage << ": " << std::fixed << std::setprecision(2) << t
+                    << " s simulated, kinetic energy per grain " << std::scientific
+                    << std::setprecision(2) << e << " J\n"
+                    << std::defaultfloat << std::setprecision(6);
+          last = t;
+        }
+      }));
+      std::cerr << "settled: packing fraction " << s.packing_fraction << ", lid at "
+                << s.lid_height * 100 << " cm, " << s.contacts_per_grain << " contacts per grain\n";
+      state.settings = v;
+    }
+
+    CyclicOptions c;
+    c.cycles = whole(v, "cycles");
+    const std::string& amplitude = v.at("amplitude");
+    c.drive.amplitude =
+        !amplitude.empty() && amplitude.back() == '%'
+            ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") /
+                  100 * sim->container().size.y()
+            : si(v, "amplitude", Dimension::length);
+    c.drive.symmetry = parse_drive_symmetry(v.at("drive"));
+    c.drive.shape = parse_drive_shape(v.at("wall-motion"));
+    if (v.at("period") == "auto") {
+      // Under the lid the confining pressure is its weight over the box; the lateral stress
+      // just beneath it, about half that, is the smallest in the packing.
+      const Container& box_now = sim->container();
+      const double lid_pressure =
+          box_now.lid.present
+              ? box_now.lid.mass * physics.gravity / (box_now.size.x() * box_now.size.y())
+              : physics.density * 0.6 * physics.gravity * 2 * radius;
+      const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_now.size.y(),
+                                                   2 * radius, 0.5 * lid_pressure, physics.density);
+      c.drive.period =
+          WallDrive::period_for_speed(c.drive.amplitude, speed, c.drive.symmetry, c.drive.shape);
+    } else {
+      c.drive.period = si(v, "period", Dimension::time);
+    }
+    c.out = out;
+    c.full_compression_frames = v.at("full-compression") == "true";
+    std::stringstream track(v.at("track"));
+    for (std::string id; std::getline(track, id, ',');) {
+      if (!id.empty()) c.tracked_grains.push_back(std::stoll(id));
+    }
+    c.samples_per_cycle = whole(v, "samples-per-cycle");
+    c.checkpoint = checkpoint;
+    c.checkpoint_every = whole(v, "checkpoint-every");
+    for (const auto& [key, value] : v)
+      c.parameters["simulate/" + key] = value;
+    const double steps_per_cycle = std::round(c.drive.period / physics.dt);
+    std::cerr << "cycling: A = " << c.drive.amplitude * 100 << " cm, period " << c.drive.period
+              << " s (" << std::int64_t(steps_per_cycle) << " steps, peak wall speed "
+              << c.drive.peak_speed() * 100 << " cm/s), " << c.cycles << " cycles\n";
+
+    const CyclicSummary summary = run_cycles(
+        *sim, c, state,
+        [](const CyclicProgress& p) {
+          std::cerr << "cycle " << p.cycle << "/" << p.cycles << "  " << std::scientific
+                    << std::setprecision(2) << p.particle_steps_per_second << std::defaultfloat
+                    << std::setprecision(6) << " particle-steps/s  "
+                    << duration_text(p.seconds_left) << " left\n";
+        },
+        &g_stop);
+    if (summary.interrupted) {
+      std::cerr << "stopped after cycle " << summary.cycles_done << ": checkpoint " << checkpoint
+                << " (continue with --resume " << checkpoint << ")\n";
+      std::signal(SIGINT, SIG_DFL);
+      throw CLI::RuntimeError(130);
+    }
+    std::cout << "simulated " << summary.cycles_done << " cycles of " << sim->grains().size()
+              << " grains: " << std::scientific << std::setprecision(3)
+              << summary.particle_steps_per_second << std::defaultfloat << " particle-steps/s\n";
+    for (const auto& p : summary.written)
+      std::cout << "wrote " << p.string() << "\n";
+    std::cout << "wrote " << checkpoint << "\n";
+  });
+}
+
+}  // namespace granmem::app

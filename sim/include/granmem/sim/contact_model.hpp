@@ -1,0 +1,78 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "granmem/sim/contact_geometry.hpp"
+#include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/normal_force.hpp"
+#include "granmem/sim/rolling_friction.hpp"
+#include "granmem/sim/sliding_friction.hpp"
+#include "granmem/sim/twisting_friction.hpp"
+
+namespace granmem {
+
+// What a contact remembers over its life: the stretch of its three springs. Zero when the
+// contact forms; forgotten when it breaks.
+struct ContactHistory {
+  Eigen::Vector3d slide = Eigen::Vector3d::Zero();
+  Eigen::Vector3d roll = Eigen::Vector3d::Zero();
+  double twist = 0;
+};
+
+// Forces and moments of one contact in one step, and the history it leaves.
+struct ContactForces {
+  Eigen::Vector3d force_on_i;  // the force on j is the opposite
+  Eigen::Vector3d torque_on_i;
+  Eigen::Vector3d torque_on_j;  // unused for a wall
+  double normal_force = 0;      // signed, along n
+  ContactHistory history;
+};
+
+// The paper's contact law, composed of its modes. Evaluating a contact is a pure function
+// of its geometry and its history before the step: nothing changes until the caller
+// stores the returned history, which the simulation does in one place.
+class ContactModel {
+ public:
+  // `mu_s`, `mu_r`, `mu_t` may differ from the parameters' (walls have their own friction).
+  ContactModel(const ContactParameters& p, double mu_s, double mu_r, double mu_t)
+      : normal_(p), sliding_(p, mu_s), rolling_(p, mu_r), twisting_(p, mu_t, mu_s) {}
+  explicit ContactModel(const ContactParameters& p) : ContactModel(p, p.mu_s, p.mu_r, p.mu_t) {}
+
+  ContactForces evaluate(const ContactGeometry& g, const ContactHistory& before, double dt) const {
+    ContactForces out;
+    const double fn = normal_.magnitude(g);
+    out.normal_force = fn;
+    const SpringSlider slide = sliding_.evaluate(g, fn, before.slide, dt);
+    out.history.slide = slide.spring;
+    out.force_on_i = fn * g.n + slide.force;
+    // The tangential force acts at the contact point: -l n from each centre's view.
+    const Eigen::Vector3d n_cross_ft = g.n.cross(slide.force);
+    out.torque_on_i = -g.l_i * n_cross_ft;
+    out.torque_on_j = g.wall ? Eigen::Vector3d::Zero() : Eigen::Vector3d(-g.l_j * n_cross_ft);
+    if (rolling_.enabled) {
+      const SpringSlider roll = rolling_.evaluate(g, fn, before.roll, dt);
+      out.history.roll = roll.spring;
+      const Eigen::Vector3d moment = g.l_ij * g.n.cross(roll.force);
+      out.torque_on_i += moment;
+      out.torque_on_j -= moment;
+    }
+    if (twisting_.enabled) {
+      const TwistingFriction::Result twist = twisting_.evaluate(g, fn, before.twist, dt);
+      out.history.twist = twist.spring;
+      const Eigen::Vector3d moment = g.l_ij * twist.force * g.n;
+      out.torque_on_i += moment;
+      out.torque_on_j -= moment;
+    }
+    return out;
+  }
+
+  const NormalForce& normal() const { return normal_; }
+
+ private:
+  NormalForce normal_;
+  SlidingFriction sliding_;
+  RollingFriction rolling_;
+  TwistingFriction twisting_;
+};
+
+}  // namespace granmem

@@ -1,0 +1,60 @@
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "granmem/sim/checkpoint.hpp"
+#include "granmem/sim/simulation.hpp"
+#include "granmem/sim/wall_drive.hpp"
+
+namespace granmem {
+
+// Cyclic compression by the driven wall, with the outputs the analysis reads.
+struct CyclicOptions {
+  WallDrive drive;
+  std::int64_t cycles = 1;
+  std::filesystem::path out;  // end-of-cycle trajectory store
+  // Also a store of frames at full compression: <out stem>_full_compression.h5.
+  bool full_compression_frames = false;
+  // In-cycle samples of these grains (ids), `samples_per_cycle` per cycle:
+  // <out stem>_in_cycle.h5.
+  std::vector<std::int64_t> tracked_grains;
+  std::int64_t samples_per_cycle = 0;
+  std::filesystem::path checkpoint;               // where checkpoints go; empty: none
+  std::int64_t checkpoint_every = 0;              // cycles between checkpoints; 0: at the end only
+  std::map<std::string, std::string> parameters;  // written into the outputs' /parameters
+};
+
+struct CyclicProgress {
+  std::int64_t cycle = 0, cycles = 0;  // cycles completed, of
+  double particle_steps_per_second = 0;
+  double seconds_left = 0;
+};
+
+struct CyclicSummary {
+  std::int64_t cycles_done = 0;
+  bool interrupted = false;  // stopped by `stop`; a checkpoint was written
+  double wall_seconds = 0;
+  double particle_steps_per_second = 0;
+  std::vector<std::filesystem::path> written;
+};
+
+std::filesystem::path full_compression_path(const std::filesystem::path& out);
+std::filesystem::path in_cycle_path(const std::filesystem::path& out);
+
+// Runs the cycles from `state` (a fresh ProtocolState starts at cycle 1 and writes the
+// state before it as frame 0; one read from a checkpoint continues where it stopped,
+// appending to the outputs). End-of-cycle frames hold every grain's position, orientation
+// and cavity axis; per-cycle observables: wall_force and wall_force_full_compression (N,
+// the packing's push on the driven wall), lid_height (m), packing_fraction,
+// kinetic_energy (J), contacts_per_grain. Checks `stop` every step: when set, it writes
+// a checkpoint and returns.
+CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& options, ProtocolState& state,
+                         const std::function<void(const CyclicProgress&)>& progress = {},
+                         const std::atomic<bool>* stop = nullptr);
+
+}  // namespace granmem

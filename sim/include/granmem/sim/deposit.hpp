@@ -1,0 +1,61 @@
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <string>
+
+#include "granmem/sim/simulation.hpp"
+
+namespace granmem {
+
+// Preparing a packing: grains inserted without overlap on a loose jittered lattice in the
+// (tall) box, falling and settling under gravity, then the lid placed on top and the
+// packing settled again. A seed makes it reproducible.
+struct DepositOptions {
+  std::int64_t grains = 2000;
+  double radius = 0.0025;     // m (0.5 cm grains)
+  double polydispersity = 0;  // radii uniform in radius * [1 - p, 1 + p]
+  double box_side = 0.15;     // m, square box
+  double lid_mass = 1.0;      // kg; 0: no lid
+  std::uint64_t seed = 1;
+  double insertion_speed = 0.05;  // rms random velocity at insertion, m/s
+  // Settled when the kinetic energy per grain is below this, J.
+  double settled_energy = 1e-13;
+  double settling_damping = 5.0;  // background drag rate while settling, 1/s
+  double max_settling_time = 10;  // s, per stage; not settled by then is an error
+};
+
+struct DepositSummary {
+  double lid_height = 0;  // m
+  double packing_fraction = 0;
+  double settling_time = 0;  // simulated, s
+  double contacts_per_grain = 0;
+};
+
+// Progress of a long stage: simulated time, kinetic energy per grain.
+using DepositProgress = std::function<void(const std::string& stage, double time, double energy)>;
+
+Simulation deposit(const DepositOptions& options, const PhysicsOptions& physics,
+                   DepositSummary* summary = nullptr, const DepositProgress& progress = {});
+
+// Volume fraction of grains under the lid (or under the highest grain top without one),
+// between the driven wall and the far wall.
+double packing_fraction(const Simulation& sim);
+// Top of the packing: the lid, or the highest grain top.
+double packing_height(const Simulation& sim);
+
+// Uniform and normal deviates from the 64-bit Mersenne Twister, whose raw sequence the
+// C++ standard fixes, transformed here rather than by <random>'s distributions, whose
+// results differ between standard libraries.
+class Random {
+ public:
+  explicit Random(std::uint64_t seed) : engine_(seed) {}
+  double uniform() { return double(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double normal();
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+}  // namespace granmem

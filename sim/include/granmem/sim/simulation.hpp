@@ -1,0 +1,123 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "granmem/sim/contact_model.hpp"
+#include "granmem/sim/container.hpp"
+#include "granmem/sim/grains.hpp"
+#include "granmem/sim/neighbor_list.hpp"
+
+namespace granmem {
+
+// Friction of grains on the container's walls and lid (same law as between grains).
+struct WallFriction {
+  double mu_s = 0.2;
+  double mu_r = 0.01;
+  double mu_t = 0.001;
+};
+
+// The physics and numerics of a run, SI units. Defaults: the paper's table.
+struct PhysicsOptions {
+  ContactParameters contact;
+  WallFriction wall;
+  double density = 1180.0;  // acrylic, kg/m^3
+  double gravity = 9.81;    // m/s^2, along -z
+  double dt = 25e-6;        // s
+  double skin = 5e-4;       // neighbour-list skin, m
+  // Drag -rate m v and -rate I w on every grain, 1/s. Only to speed up settling; 0 while
+  // driven.
+  double background_damping = 0;
+  // Fewest time steps a collision must last; see validate().
+  double min_steps_per_collision = 10;
+
+  // Throws Error naming `where` for unphysical values, and for a time step that resolves
+  // the shortest collision between grains of these radii in fewer than
+  // min_steps_per_collision steps (the explicit integration would be inaccurate).
+  void validate(const std::string& where, double min_radius) const;
+};
+
+// Forces the grains exert on the walls at the last step.
+struct WallLoads {
+  std::array<Eigen::Vector3d, kWallCount> force{};
+  std::array<int, kWallCount> contacts{};
+};
+
+// A soft-sphere DEM of grains in the container: velocity Verlet for positions, angular
+// velocities and orientations, forces from ContactModel between grains and against walls,
+// gravity, and the lid's motion along z. Forces on a grain are summed over its contacts in
+// the order of the partners' ids, so results do not depend on the thread count, on when
+// the neighbour list is rebuilt, or on the grains' order in memory.
+class Simulation {
+ public:
+  Simulation(Grains grains, Container container, PhysicsOptions physics);
+
+  // The driven wall's position and velocity at time t; default: at rest where it is.
+  using WallMotion = std::function<std::pair<double, double>(double t)>;
+  void set_wall_motion(WallMotion motion) { wall_motion_ = std::move(motion); }
+
+  void step();
+  void run(std::int64_t steps);
+
+  double time() const { return time_; }
+  std::int64_t step_count() const { return step_count_; }
+  const Grains& grains() const { return grains_; }
+  Grains& grains() { return grains_; }
+  const Container& container() const { return container_; }
+  Container& container() { return container_; }
+  const PhysicsOptions& physics() const { return physics_; }
+  void set_background_damping(double rate) { physics_.background_damping = rate; }
+  const WallLoads& wall_loads() const { return wall_loads_; }
+  // Grain-grain contacts at the last step.
+  std::size_t contact_count() const;
+  double kinetic_energy() const { return grains_.kinetic_energy(); }
+
+  // Contact history, for checkpoints: every touching grain pair as (id, id, history), and
+  // each grain's history against each wall.
+  struct PairRecord {
+    std::int64_t id_a, id_b;
+    ContactHistory history;
+  };
+  std::vector<PairRecord> pair_histories() const;
+  const std::vector<std::array<ContactHistory, kWallCount>>& wall_histories() const {
+    return wall_history_;
+  }
+  // Restores a checkpoint's state: time, step, and the histories above.
+  void restore(double time, std::int64_t steps, const std::vector<PairRecord>& pairs,
+               std::vector<std::array<ContactHistory, kWallCount>> walls);
+  // Sets the forces and torques for the first half-kick without touching any history;
+  // called by the constructor, and after grains or walls are moved by hand.
+  void refresh_forces();
+
+ private:
+  void compute_forces(bool commit);
+  void rebuild_neighbors();
+
+  struct PairForce {
+    Eigen::Vector3d force_on_i, torque_on_i, torque_on_j;
+  };
+
+  Grains grains_;
+  Container container_;
+  PhysicsOptions physics_;
+  ContactModel grain_contact_, wall_contact_;
+  WallMotion wall_motion_;
+  NeighborList neighbors_;
+  std::vector<ContactHistory> pair_history_;
+  std::vector<std::uint8_t> touching_;  // the pair has a committed contact history
+  std::vector<std::uint8_t> active_;    // the pair overlaps at the last force evaluation
+  std::vector<PairForce> pair_force_;
+  std::vector<std::array<ContactHistory, kWallCount>> wall_history_;
+  std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
+  std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
+  WallLoads wall_loads_;
+  double time_ = 0;
+  std::int64_t step_count_ = 0;
+};
+
+}  // namespace granmem

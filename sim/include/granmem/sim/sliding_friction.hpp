@@ -1,0 +1,61 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "granmem/sim/contact_geometry.hpp"
+#include "granmem/sim/contact_parameters.hpp"
+
+namespace granmem {
+
+// Keeps a contact spring in the current tangent plane: the part along n is removed and the
+// length kept, so that a contact turning as a whole neither gains nor loses spring energy.
+inline Eigen::Vector3d onto_tangent_plane(const Eigen::Vector3d& spring, const Eigen::Vector3d& n) {
+  const double length_sq = spring.squaredNorm();
+  if (length_sq == 0) return spring;
+  const Eigen::Vector3d t = spring - spring.dot(n) * n;
+  const double t_sq = t.squaredNorm();
+  return t_sq > 0 ? Eigen::Vector3d(t * std::sqrt(length_sq / t_sq)) : Eigen::Vector3d::Zero();
+}
+
+// A spring-dashpot capped by a Coulomb slider: F = -k s - C v, |F| <= cap. Where it slips,
+// the spring is rewritten to match the capped force. Shared by sliding and rolling.
+struct SpringSlider {
+  Eigen::Vector3d force;
+  Eigen::Vector3d spring;  // history after this step
+};
+inline SpringSlider spring_slider(const Eigen::Vector3d& spring_before, const Eigen::Vector3d& n,
+                                  const Eigen::Vector3d& velocity, double dt, double k, double c,
+                                  double cap) {
+  SpringSlider out;
+  out.spring = onto_tangent_plane(spring_before, n) + velocity * dt;
+  out.force = -k * out.spring - c * velocity;
+  const double f_sq = out.force.squaredNorm();
+  if (f_sq > cap * cap) {
+    out.force *= cap / std::sqrt(f_sq);
+    out.spring = k > 0 ? Eigen::Vector3d(-(out.force + c * velocity) / k) : Eigen::Vector3d::Zero();
+  }
+  return out;
+}
+
+// Sliding friction: a tangential spring k_t that accumulates the tangential relative
+// displacement over the life of a contact, a dashpot from the tangential restitution, and
+// Coulomb's cap mu_s |F_n|. The torque on grain i is l_i (-n x F_t).
+struct SlidingFriction {
+  double k = 0;
+  double damping_per_sqrt_mass = 0;  // C_t / sqrt(m_red)
+  double mu = 0;
+
+  SlidingFriction(const ContactParameters& p, double mu_s)
+      : k(p.k_t()),
+        damping_per_sqrt_mass(dashpot_coefficient(p.k_t(), p.restitution_t, 1.0)),
+        mu(mu_s) {}
+
+  SpringSlider evaluate(const ContactGeometry& g, double normal_force,
+                        const Eigen::Vector3d& spring, double dt) const {
+    return spring_slider(spring, g.n, g.v_t, dt, k, damping_per_sqrt_mass * g.sqrt_reduced_mass,
+                         mu * std::abs(normal_force));
+  }
+};
+
+}  // namespace granmem

@@ -1,0 +1,39 @@
+#pragma once
+
+#include <string>
+#include <utility>
+
+namespace granmem {
+
+// How the driven wall moves in one cycle. Asymmetric: 0 -> A -> 0 (the paper's drive);
+// symmetric: 0 -> A/2 -> -A/2 -> 0 (its appendix). Positive compresses the packing.
+enum class DriveSymmetry { asymmetric, symmetric };
+enum class DriveShape { cosine, linear };  // smooth start and stop, or constant speed
+
+struct WallDrive {
+  double amplitude = 0;  // A, m
+  double period = 0;     // s
+  DriveSymmetry symmetry = DriveSymmetry::asymmetric;
+  DriveShape shape = DriveShape::cosine;
+
+  // Wall position and velocity at time s into a cycle (0 <= s <= period).
+  std::pair<double, double> at(double s) const;
+  // Fastest wall speed over a cycle.
+  double peak_speed() const;
+  // Time into a cycle of the strongest compression (A, or A/2 for the symmetric drive).
+  double full_compression_time() const;
+  // The period whose peak speed is `speed`.
+  static double period_for_speed(double amplitude, double speed, DriveSymmetry symmetry,
+                                 DriveShape shape);
+};
+
+// The quasi-static limit: the inertial number I = (strain rate) d / sqrt(P / rho) of a
+// packing of grain diameter d and density rho under pressure P, sheared at strain rate
+// (wall speed / box length). Returns the wall speed that gives `inertial_number`.
+double quasi_static_wall_speed(double inertial_number, double box_length, double diameter,
+                               double pressure, double density);
+
+DriveSymmetry parse_drive_symmetry(const std::string& text);
+DriveShape parse_drive_shape(const std::string& text);
+
+}  // namespace granmem

@@ -1,0 +1,120 @@
+#include "granmem/sim/deposit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+
+double Random::normal() {
+  // Box-Muller; 1 - u keeps the logarithm finite.
+  const double u = 1.0 - uniform(), v = uniform();
+  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * M_PI * v);
+}
+
+double packing_height(const Simulation& sim) {
+  if (sim.container().lid.present) return sim.container().lid.z;
+  const Grains& g = sim.grains();
+  double top = 0;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    top = std::max(top, g.x[i].z() + g.radius[i]);
+  return top;
+}
+
+double packing_fraction(const Simulation& sim) {
+  const Grains& g = sim.grains();
+  const Container& c = sim.container();
+  double volume = 0;
+  for (double r : g.radius)
+    volume += 4.0 / 3.0 * M_PI * r * r * r;
+  const double box = c.size.x() * (c.size.y() - c.y_wall) * packing_height(sim);
+  return box > 0 ? volume / box : 0;
+}
+
+namespace {
+
+// Runs with the settling drag until the kinetic energy per grain is below the threshold.
+double settle(Simulation& sim, const DepositOptions& o, const std::string& stage,
+              const DepositProgress& progress) {
+  const double n = double(std::max<std::size_t>(sim.grains().size(), 1));
+  const auto chunk = std::max<std::int64_t>(1, std::llround(0.01 / sim.physics().dt));
+  const double start = sim.time();
+  sim.set_background_damping(o.settling_damping);
+  while (true) {
+    sim.run(chunk);
+    const double energy = sim.kinetic_energy() / n;
+    if (progress) progress(stage, sim.time() - start, energy);
+    if (energy < o.settled_energy) break;
+    if (sim.time() - start > o.max_settling_time) {
+      throw Error("deposit: " + stage + " not settled after " +
+                  std::to_string(o.max_settling_time) +
+                  " s of simulated time (kinetic energy per grain " + std::to_string(energy) +
+                  " J, wanted < " + std::to_string(o.settled_energy) + " J)");
+    }
+  }
+  sim.set_background_damping(0);
+  return sim.time() - start;
+}
+
+}  // namespace
+
+Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, DepositSummary* summary,
+                   const DepositProgress& progress) {
+  if (o.grains < 1) throw Error("deposit: needs at least one grain");
+  if (!(o.radius > 0)) throw Error("deposit: grain radius must be positive");
+  if (!(o.polydispersity >= 0 && o.polydispersity < 1)) {
+    throw Error("deposit: polydispersity must be in [0, 1)");
+  }
+  const double r_max = o.radius * (1 + o.polydispersity);
+  if (!(o.box_side > 4 * r_max)) throw Error("deposit: the box must be wider than two grains");
+  if (!(o.lid_mass >= 0)) throw Error("deposit: lid mass must be zero or positive");
+  physics.validate("deposit", o.radius * (1 - o.polydispersity));
+
+  // A loose lattice with gaps, so that random shifts never make grains overlap.
+  Random random(o.seed);
+  const double spacing = 2.4 * r_max, jitter = 0.45 * (spacing - 2 * r_max);
+  const auto per_row =
+      static_cast<std::int64_t>(std::floor((o.box_side - 2 * r_max) / spacing)) + 1;
+  Grains grains;
+  for (std::int64_t k = 0; k < o.grains; ++k) {
+    const std::int64_t layer = k / (per_row * per_row), in_layer = k % (per_row * per_row);
+    const Eigen::Vector3d site(r_max + spacing * double(in_layer % per_row),
+                               r_max + spacing * double(in_layer / per_row),
+                               r_max + spacing * double(layer));
+    const Eigen::Vector3d shift(jitter * (2 * random.uniform() - 1),
+                                jitter * (2 * random.uniform() - 1), jitter * random.uniform());
+    const double r = o.radius * (1 + o.polydispersity * (2 * random.uniform() - 1));
+    grains.add(k, site + shift, r, physics.density);
+    grains.v.back() =
+        o.insertion_speed * Eigen::Vector3d(random.normal(), random.normal(), random.normal());
+    // Random orientation: a normalised Gaussian quaternion is uniform on rotations.
+    Eigen::Quaterniond q(random.normal(), random.normal(), random.normal(), random.normal());
+    grains.q.back() = q.normalized();
+  }
+  Container box;
+  box.size = {o.box_side, o.box_side};
+
+  Simulation sim(std::move(grains), box, physics);
+  double settling = settle(sim, o, "falling", progress);
+
+  if (o.lid_mass > 0) {
+    const double top = packing_height(sim);
+    Lid& lid = sim.container().lid;
+    lid.present = true;
+    lid.mass = o.lid_mass;
+    lid.z = top;  // resting on the highest grain
+    lid.v = 0;
+    sim.refresh_forces();
+    settling += settle(sim, o, "under the lid", progress);
+  }
+  if (summary) {
+    summary->lid_height = packing_height(sim);
+    summary->packing_fraction = packing_fraction(sim);
+    summary->settling_time = settling;
+    summary->contacts_per_grain = 2.0 * double(sim.contact_count()) / double(sim.grains().size());
+  }
+  return sim;
+}
+
+}  // namespace granmem

@@ -1,0 +1,267 @@
+#include "granmem/sim/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+
+void PhysicsOptions::validate(const std::string& where, double min_radius) const {
+  contact.validate(where);
+  auto require = [&](bool ok, const std::string& what) {
+    if (!ok) throw Error(where + ": " + what);
+  };
+  require(std::isfinite(density) && density > 0, "density must be positive");
+  require(std::isfinite(gravity) && gravity >= 0, "gravity must be zero or positive");
+  require(std::isfinite(dt) && dt > 0, "time step must be positive");
+  require(std::isfinite(skin) && skin > 0, "neighbour skin must be positive");
+  require(std::isfinite(background_damping) && background_damping >= 0,
+          "background damping must be zero or positive");
+  require(wall.mu_s >= 0 && wall.mu_r >= 0 && wall.mu_t >= 0, "wall friction must be >= 0");
+  require(min_radius > 0, "grain radius must be positive");
+  // The shortest collision: two of the smallest grains (a wall, of infinite mass, gives a
+  // longer one).
+  const double m = 4.0 / 3.0 * M_PI * std::pow(min_radius, 3) * density;
+  const double duration = contact_duration(contact.k_n, contact.restitution_n, m / 2);
+  if (duration < min_steps_per_collision * dt) {
+    throw Error(where + ": time step " + std::to_string(dt * 1e6) + " us resolves a collision of " +
+                std::to_string(duration * 1e6) + " us (k_n " + std::to_string(contact.k_n) +
+                " N/m, radius " + std::to_string(min_radius) + " m) in " +
+                std::to_string(duration / dt) + " steps; it needs at least " +
+                std::to_string(min_steps_per_collision) +
+                ": use dt <= " + std::to_string(duration / min_steps_per_collision * 1e6) + " us");
+  }
+}
+
+Simulation::Simulation(Grains grains, Container container, PhysicsOptions physics)
+    : grains_(std::move(grains)),
+      container_(container),
+      physics_(physics),
+      grain_contact_(physics.contact),
+      wall_contact_(physics.contact, physics.wall.mu_s, physics.wall.mu_r, physics.wall.mu_t),
+      neighbors_(physics.skin) {
+  const double r_min =
+      grains_.size() ? *std::min_element(grains_.radius.begin(), grains_.radius.end()) : 1.0;
+  physics_.validate("simulation", r_min);
+  wall_history_.assign(grains_.size(), {});
+  wall_force_on_grain_.assign(grains_.size(), {});
+  wall_touch_.assign(grains_.size(), 0);
+  rebuild_neighbors();
+  refresh_forces();
+}
+
+void Simulation::rebuild_neighbors() {
+  NeighborList next(physics_.skin);
+  next.build(grains_);
+  pair_history_ = next.carry(neighbors_, pair_history_, grains_.id, ContactHistory{});
+  touching_ = next.carry(neighbors_, touching_, grains_.id, std::uint8_t{0});
+  neighbors_ = std::move(next);
+  pair_force_.resize(neighbors_.pair_count());
+  active_.assign(neighbors_.pair_count(), 0);
+}
+
+void Simulation::refresh_forces() {
+  compute_forces(false);
+}
+
+void Simulation::compute_forces(bool commit) {
+  const std::size_t n = grains_.size();
+  const double dt = physics_.dt;
+  const auto& partner = neighbors_.partner();
+  Grains& g = grains_;
+
+  // Grain pairs: each evaluated once, by its owner.
+#pragma omp parallel for schedule(dynamic, 128)
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d xi = g.x[i];
+    const double ri = g.radius[i];
+    for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
+      const std::uint32_t j = partner[k];
+      const double reach = ri + g.radius[j];
+      if ((xi - g.x[j]).squaredNorm() >= reach * reach) {
+        active_[k] = 0;
+        if (commit && touching_[k]) {
+          touching_[k] = 0;
+          pair_history_[k] = ContactHistory{};  // the contact broke: forget its springs
+        }
+        continue;
+      }
+      const ContactGeometry geometry = sphere_contact(xi, g.x[j], ri, g.radius[j], g.v[i], g.v[j],
+                                                      g.w[i], g.w[j], g.mass[i], g.mass[j]);
+      const ContactForces f = grain_contact_.evaluate(geometry, pair_history_[k], dt);
+      pair_force_[k] = {f.force_on_i, f.torque_on_i, f.torque_on_j};
+      active_[k] = 1;
+      if (commit) {
+        pair_history_[k] = f.history;
+        touching_[k] = 1;
+      }
+    }
+  }
+
+  // Each grain: its pairs in partner-id order, then the walls in a fixed order.
+  const Eigen::Vector3d gravity(0, 0, -physics_.gravity);
+  const double drag = physics_.background_damping;
+  const auto& incoming = neighbors_.incoming();
+  const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
+  std::array<Container::Plane, kWallCount> planes;
+  for (int w = 0; w < walls; ++w)
+    planes[w] = container_.plane(static_cast<Wall>(w));
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d f = g.mass[i] * gravity - drag * g.mass[i] * g.v[i];
+    Eigen::Vector3d t = -drag / g.inv_inertia[i] * g.w[i];
+    for (std::uint32_t s = neighbors_.incoming_begin(i); s < neighbors_.incoming_end(i); ++s) {
+      const std::uint32_t k = incoming[s];
+      if (!active_[k]) continue;
+      f -= pair_force_[k].force_on_i;
+      t += pair_force_[k].torque_on_j;
+    }
+    for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
+      if (!active_[k]) continue;
+      f += pair_force_[k].force_on_i;
+      t += pair_force_[k].torque_on_i;
+    }
+    std::uint8_t touch = 0;
+    for (int w = 0; w < walls; ++w) {
+      const Container::Plane& p = planes[w];
+      const double distance = p.normal.dot(g.x[i]) - p.offset;
+      ContactHistory& history = wall_history_[i][w];
+      if (distance >= g.radius[i]) {
+        if (commit) history = ContactHistory{};
+        continue;
+      }
+      const ContactGeometry geometry =
+          wall_contact(distance, p.normal, g.radius[i], g.v[i], g.w[i], g.mass[i], p.velocity);
+      const ContactForces c = wall_contact_.evaluate(geometry, history, dt);
+      if (commit) history = c.history;
+      f += c.force_on_i;
+      t += c.torque_on_i;
+      wall_force_on_grain_[i][w] = -c.force_on_i;
+      touch |= std::uint8_t(1u << w);
+    }
+    wall_touch_[i] = touch;
+    g.force[i] = f;
+    g.torque[i] = t;
+  }
+
+  // Loads on the walls, summed in grain order (the lid's motion depends on them).
+  wall_loads_ = WallLoads{};
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!wall_touch_[i]) continue;
+    for (int w = 0; w < walls; ++w) {
+      if (wall_touch_[i] & (1u << w)) {
+        wall_loads_.force[w] += wall_force_on_grain_[i][w];
+        ++wall_loads_.contacts[w];
+      }
+    }
+  }
+  if (container_.lid.present) {
+    container_.lid.force =
+        wall_loads_.force[int(Wall::lid)].z() - container_.lid.mass * physics_.gravity;
+  }
+}
+
+void Simulation::step() {
+  const double dt = physics_.dt, half = 0.5 * dt;
+  Grains& g = grains_;
+  const std::size_t n = g.size();
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    g.v[i] += half * g.inv_mass[i] * g.force[i];
+    g.w[i] += half * g.inv_inertia[i] * g.torque[i];
+    g.x[i] += dt * g.v[i];
+    // Turn by the rotation vector w dt, exactly (a sphere's w is constant over the step).
+    const double angle = g.w[i].norm() * dt;
+    if (angle > 0) {
+      g.q[i] = Eigen::Quaterniond(Eigen::AngleAxisd(angle, g.w[i] / g.w[i].norm())) * g.q[i];
+      g.q[i].normalize();
+    }
+  }
+  Lid& lid = container_.lid;
+  if (lid.present) {
+    lid.v += half * lid.force / lid.mass;
+    lid.z += dt * lid.v;
+  }
+  time_ += dt;
+  ++step_count_;
+  if (wall_motion_) {
+    std::tie(container_.y_wall, container_.y_wall_velocity) = wall_motion_(time_);
+  }
+  if (neighbors_.stale(g)) rebuild_neighbors();
+
+  compute_forces(true);
+
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {
+    g.v[i] += half * g.inv_mass[i] * g.force[i];
+    g.w[i] += half * g.inv_inertia[i] * g.torque[i];
+  }
+  if (lid.present) lid.v += half * lid.force / lid.mass;
+}
+
+void Simulation::run(std::int64_t steps) {
+  for (std::int64_t s = 0; s < steps; ++s)
+    step();
+}
+
+std::size_t Simulation::contact_count() const {
+  std::size_t c = 0;
+  for (std::uint8_t t : active_)
+    c += t;
+  return c;
+}
+
+std::vector<Simulation::PairRecord> Simulation::pair_histories() const {
+  std::vector<PairRecord> out;
+  const auto& owner = neighbors_.owner();
+  const auto& partner = neighbors_.partner();
+  for (std::size_t k = 0; k < partner.size(); ++k) {
+    if (touching_[k]) {
+      out.push_back({grains_.id[owner[k]], grains_.id[partner[k]], pair_history_[k]});
+    }
+  }
+  return out;
+}
+
+void Simulation::restore(double time, std::int64_t steps, const std::vector<PairRecord>& pairs,
+                         std::vector<std::array<ContactHistory, kWallCount>> walls) {
+  if (walls.size() != grains_.size()) {
+    throw Error("checkpoint: wall histories for " + std::to_string(walls.size()) +
+                " grains, the state has " + std::to_string(grains_.size()));
+  }
+  time_ = time;
+  step_count_ = steps;
+  wall_history_ = std::move(walls);
+  std::unordered_map<std::int64_t, std::uint32_t> index;
+  for (std::size_t i = 0; i < grains_.size(); ++i)
+    index[grains_.id[i]] = std::uint32_t(i);
+  neighbors_ = NeighborList(physics_.skin);
+  rebuild_neighbors();
+  std::fill(pair_history_.begin(), pair_history_.end(), ContactHistory{});
+  std::fill(touching_.begin(), touching_.end(), 0);
+  const auto& partner = neighbors_.partner();
+  for (const PairRecord& p : pairs) {
+    const auto a = index.find(p.id_a), b = index.find(p.id_b);
+    if (a == index.end() || b == index.end()) {
+      throw Error("checkpoint: contact between unknown grains " + std::to_string(p.id_a) + " and " +
+                  std::to_string(p.id_b));
+    }
+    const std::uint32_t i = a->second;
+    bool found = false;
+    for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
+      if (partner[k] == b->second) {
+        pair_history_[k] = p.history;
+        touching_[k] = 1;
+        found = true;
+      }
+    }
+    if (!found) {
+      throw Error("checkpoint: grains " + std::to_string(p.id_a) + " and " +
+                  std::to_string(p.id_b) + " are in contact but not neighbours");
+    }
+  }
+}
+
+}  // namespace granmem

@@ -7,6 +7,29 @@
 #include "granmem/core/error.hpp"
 
 namespace granmem {
+namespace {
+
+// Orientation q turned by the rotation vector `turn` (a sphere's w is constant over a
+// step, so this is exact). For the small turns of a step, sin and cos of the half angle
+// come from their series, exact to double precision below 1e-2 rad.
+Eigen::Quaterniond turned(const Eigen::Quaterniond& q, const Eigen::Vector3d& turn) {
+  const double angle_sq = turn.squaredNorm();
+  if (angle_sq == 0) return q;
+  double c, s_over_angle;  // cos(angle/2), sin(angle/2)/angle
+  if (angle_sq < 1e-4) {
+    const double h2 = 0.25 * angle_sq;  // (angle/2)^2
+    c = 1 - h2 / 2 * (1 - h2 / 12 * (1 - h2 / 30 * (1 - h2 / 56)));
+    s_over_angle = 0.5 * (1 - h2 / 6 * (1 - h2 / 20 * (1 - h2 / 42 * (1 - h2 / 72))));
+  } else {
+    const double angle = std::sqrt(angle_sq);
+    c = std::cos(0.5 * angle);
+    s_over_angle = std::sin(0.5 * angle) / angle;
+  }
+  const Eigen::Vector3d v = s_over_angle * turn;
+  return (Eigen::Quaterniond(c, v.x(), v.y(), v.z()) * q).normalized();
+}
+
+}  // namespace
 
 void PhysicsOptions::validate(const std::string& where, double min_radius) const {
   contact.validate(where);
@@ -45,6 +68,10 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
   const double r_min =
       grains_.size() ? *std::min_element(grains_.radius.begin(), grains_.radius.end()) : 1.0;
   physics_.validate("simulation", r_min);
+  if (!grains_.mass.empty() && std::all_of(grains_.mass.begin(), grains_.mass.end(),
+                                           [&](double m) { return m == grains_.mass.front(); })) {
+    uniform_sqrt_reduced_mass_ = sqrt_reduced_mass(grains_.mass.front(), grains_.mass.front());
+  }
   wall_history_.assign(grains_.size(), {});
   wall_force_on_grain_.assign(grains_.size(), {});
   wall_touch_.assign(grains_.size(), 0);
@@ -88,8 +115,11 @@ void Simulation::compute_forces(bool commit) {
         }
         continue;
       }
-      const ContactGeometry geometry = sphere_contact(xi, g.x[j], ri, g.radius[j], g.v[i], g.v[j],
-                                                      g.w[i], g.w[j], g.mass[i], g.mass[j]);
+      const double sqrt_m = uniform_sqrt_reduced_mass_ > 0
+                                ? uniform_sqrt_reduced_mass_
+                                : sqrt_reduced_mass(g.mass[i], g.mass[j]);
+      const ContactGeometry geometry =
+          sphere_contact(xi, g.x[j], ri, g.radius[j], g.v[i], g.v[j], g.w[i], g.w[j], sqrt_m);
       const ContactForces f = grain_contact_.evaluate(geometry, pair_history_[k], dt);
       pair_force_[k] = {f.force_on_i, f.torque_on_i, f.torque_on_j};
       active_[k] = 1;
@@ -110,8 +140,11 @@ void Simulation::compute_forces(bool commit) {
     planes[w] = container_.plane(static_cast<Wall>(w));
 #pragma omp parallel for schedule(static)
   for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Vector3d f = g.mass[i] * gravity - drag * g.mass[i] * g.v[i];
-    Eigen::Vector3d t = -drag / g.inv_inertia[i] * g.w[i];
+    Eigen::Vector3d f = g.mass[i] * gravity, t = Eigen::Vector3d::Zero();
+    if (drag > 0) {
+      f -= drag * g.mass[i] * g.v[i];
+      t -= drag / g.inv_inertia[i] * g.w[i];
+    }
     for (std::uint32_t s = neighbors_.incoming_begin(i); s < neighbors_.incoming_end(i); ++s) {
       const std::uint32_t k = incoming[s];
       if (!active_[k]) continue;
@@ -167,17 +200,14 @@ void Simulation::step() {
   const double dt = physics_.dt, half = 0.5 * dt;
   Grains& g = grains_;
   const std::size_t n = g.size();
-#pragma omp parallel for schedule(static)
+  bool stale = false;
+#pragma omp parallel for schedule(static) reduction(|| : stale)
   for (std::size_t i = 0; i < n; ++i) {
     g.v[i] += half * g.inv_mass[i] * g.force[i];
     g.w[i] += half * g.inv_inertia[i] * g.torque[i];
     g.x[i] += dt * g.v[i];
-    // Turn by the rotation vector w dt, exactly (a sphere's w is constant over the step).
-    const double angle = g.w[i].norm() * dt;
-    if (angle > 0) {
-      g.q[i] = Eigen::Quaterniond(Eigen::AngleAxisd(angle, g.w[i] / g.w[i].norm())) * g.q[i];
-      g.q[i].normalize();
-    }
+    g.q[i] = turned(g.q[i], g.w[i] * dt);
+    stale = stale || neighbors_.moved_too_far(g.x[i], i);
   }
   Lid& lid = container_.lid;
   if (lid.present) {
@@ -189,7 +219,7 @@ void Simulation::step() {
   if (wall_motion_) {
     std::tie(container_.y_wall, container_.y_wall_velocity) = wall_motion_(time_);
   }
-  if (neighbors_.stale(g)) rebuild_neighbors();
+  if (stale) rebuild_neighbors();
 
   compute_forces(true);
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "granmem/sim/inline.hpp"
+
 namespace granmem {
 
 // What every mode of the contact law reads about one contact between grain i and body j
@@ -21,23 +23,24 @@ struct ContactGeometry {
   bool wall = false;
 };
 
-// Two spheres whose centres are `d = |x_i - x_j|` apart with d < R_i + R_j.
-inline ContactGeometry sphere_contact(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j,
-                                      double r_i, double r_j, const Eigen::Vector3d& v_i,
-                                      const Eigen::Vector3d& v_j, const Eigen::Vector3d& w_i,
-                                      const Eigen::Vector3d& w_j, double m_i, double m_j) {
+// Two spheres whose centres are `d = |x_i - x_j|` apart with d < R_i + R_j;
+// `sqrt_reduced_mass` = sqrt(m_i m_j / (m_i + m_j)), which the caller may hold constant.
+GRANMEM_INLINE ContactGeometry
+sphere_contact(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double r_i, double r_j,
+               const Eigen::Vector3d& v_i, const Eigen::Vector3d& v_j, const Eigen::Vector3d& w_i,
+               const Eigen::Vector3d& w_j, double sqrt_reduced_mass) {
   ContactGeometry g;
   const Eigen::Vector3d dx = x_i - x_j;
-  const double d = dx.norm();
-  g.n = dx / d;
+  const double d = dx.norm(), inv_d = 1.0 / d;
+  g.n = dx * inv_d;
   g.overlap = r_i + r_j - d;
   // The contact plane is the radical plane of the two spheres.
-  g.l_i = (d * d + r_i * r_i - r_j * r_j) / (2.0 * d);
+  g.l_i = (d * d + r_i * r_i - r_j * r_j) * (0.5 * inv_d);
   g.l_j = d - g.l_i;
-  g.l_ij = 2.0 * g.l_i * g.l_j / (g.l_i + g.l_j);
-  g.sqrt_reduced_mass = std::sqrt(m_i * m_j / (m_i + m_j));
+  g.l_ij = 2.0 * g.l_i * g.l_j * inv_d;  // l_i + l_j = d
+  g.sqrt_reduced_mass = sqrt_reduced_mass;
   // Surface velocities at the contact point: i's at -l_i n, j's at +l_j n.
-  const Eigen::Vector3d v = v_i - v_j + g.l_i * g.n.cross(w_i) + g.l_j * g.n.cross(w_j);
+  const Eigen::Vector3d v = v_i - v_j + g.n.cross(g.l_i * w_i + g.l_j * w_j);
   g.v_n = v.dot(g.n);
   g.v_t = v - g.v_n * g.n;
   g.w_i = w_i;
@@ -45,11 +48,16 @@ inline ContactGeometry sphere_contact(const Eigen::Vector3d& x_i, const Eigen::V
   return g;
 }
 
+GRANMEM_INLINE double sqrt_reduced_mass(double m_i, double m_j) {
+  return std::sqrt(m_i * m_j / (m_i + m_j));
+}
+
 // A sphere against a flat wall whose inward unit normal is `normal`, at signed distance
 // `distance` (< r_i) from the sphere's centre, moving with `wall_velocity`.
-inline ContactGeometry wall_contact(double distance, const Eigen::Vector3d& normal, double r_i,
-                                    const Eigen::Vector3d& v_i, const Eigen::Vector3d& w_i,
-                                    double m_i, const Eigen::Vector3d& wall_velocity) {
+GRANMEM_INLINE ContactGeometry wall_contact(double distance, const Eigen::Vector3d& normal,
+                                            double r_i, const Eigen::Vector3d& v_i,
+                                            const Eigen::Vector3d& w_i, double m_i,
+                                            const Eigen::Vector3d& wall_velocity) {
   ContactGeometry g;
   g.wall = true;
   g.n = normal;

@@ -4,6 +4,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/inline.hpp"
 #include "granmem/sim/normal_force.hpp"
 #include "granmem/sim/rolling_friction.hpp"
 #include "granmem/sim/sliding_friction.hpp"
@@ -38,31 +39,31 @@ class ContactModel {
       : normal_(p), sliding_(p, mu_s), rolling_(p, mu_r), twisting_(p, mu_t, mu_s) {}
   explicit ContactModel(const ContactParameters& p) : ContactModel(p, p.mu_s, p.mu_r, p.mu_t) {}
 
-  ContactForces evaluate(const ContactGeometry& g, const ContactHistory& before, double dt) const {
+  GRANMEM_INLINE ContactForces evaluate(const ContactGeometry& g, const ContactHistory& before,
+                                        double dt) const {
     ContactForces out;
     const double fn = normal_.magnitude(g);
     out.normal_force = fn;
     const SpringSlider slide = sliding_.evaluate(g, fn, before.slide, dt);
     out.history.slide = slide.spring;
     out.force_on_i = fn * g.n + slide.force;
-    // The tangential force acts at the contact point: -l n from each centre's view.
-    const Eigen::Vector3d n_cross_ft = g.n.cross(slide.force);
-    out.torque_on_i = -g.l_i * n_cross_ft;
-    out.torque_on_j = g.wall ? Eigen::Vector3d::Zero() : Eigen::Vector3d(-g.l_j * n_cross_ft);
+    // Moments about each centre: the tangential force acts at the contact point, -l n
+    // from i's centre and +l n from j's; rolling and twisting act through l_ij.
+    Eigen::Vector3d lever_i = -g.l_i * slide.force, lever_j = -g.l_j * slide.force;
+    double twist_moment = 0;
     if (rolling_.enabled) {
       const SpringSlider roll = rolling_.evaluate(g, fn, before.roll, dt);
       out.history.roll = roll.spring;
-      const Eigen::Vector3d moment = g.l_ij * g.n.cross(roll.force);
-      out.torque_on_i += moment;
-      out.torque_on_j -= moment;
+      lever_i += g.l_ij * roll.force;
+      lever_j -= g.l_ij * roll.force;
     }
     if (twisting_.enabled) {
       const TwistingFriction::Result twist = twisting_.evaluate(g, fn, before.twist, dt);
       out.history.twist = twist.spring;
-      const Eigen::Vector3d moment = g.l_ij * twist.force * g.n;
-      out.torque_on_i += moment;
-      out.torque_on_j -= moment;
+      twist_moment = g.l_ij * twist.force;
     }
+    out.torque_on_i = g.n.cross(lever_i) + twist_moment * g.n;
+    if (!g.wall) out.torque_on_j = g.n.cross(lever_j) - twist_moment * g.n;
     return out;
   }
 

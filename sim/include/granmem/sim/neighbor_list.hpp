@@ -21,6 +21,10 @@ class NeighborList {
   void build(const Grains& grains);
   // True once some grain has moved more than half the skin since the last build.
   bool stale(const Grains& grains) const;
+  // The same test for grain i at position x.
+  bool moved_too_far(const Eigen::Vector3d& x, std::size_t i) const {
+    return i >= built_at_.size() || (x - built_at_[i]).squaredNorm() > 0.25 * skin_ * skin_;
+  }
 
   double skin() const { return skin_; }
   std::size_t pair_count() const { return partner_.size(); }

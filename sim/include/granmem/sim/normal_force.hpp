@@ -4,6 +4,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/inline.hpp"
 
 namespace granmem {
 
@@ -16,11 +17,13 @@ struct NormalForce {
   explicit NormalForce(const ContactParameters& p)
       : k(p.k_n), damping_per_sqrt_mass(dashpot_coefficient(p.k_n, p.restitution_n, 1.0)) {}
 
-  double damping(const ContactGeometry& g) const {
+  GRANMEM_INLINE double damping(const ContactGeometry& g) const {
     return damping_per_sqrt_mass * g.sqrt_reduced_mass;
   }
   // Signed magnitude along n (> 0 pushes i away from j).
-  double magnitude(const ContactGeometry& g) const { return k * g.overlap - damping(g) * g.v_n; }
+  GRANMEM_INLINE double magnitude(const ContactGeometry& g) const {
+    return k * g.overlap - damping(g) * g.v_n;
+  }
 };
 
 }  // namespace granmem

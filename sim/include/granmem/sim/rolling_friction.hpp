@@ -2,6 +2,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/inline.hpp"
 #include "granmem/sim/sliding_friction.hpp"
 
 namespace granmem {
@@ -23,15 +24,13 @@ struct RollingFriction {
                               4.0),
         cap_per_normal_force(mu_r * p.beta) {}
 
-  static Eigen::Vector3d velocity(const ContactGeometry& g) {
-    Eigen::Vector3d v = g.l_i * g.w_i.cross(g.n);
-    if (!g.wall) v -= g.l_j * g.w_j.cross(g.n);
-    return v;
+  GRANMEM_INLINE static Eigen::Vector3d velocity(const ContactGeometry& g) {
+    return g.wall ? g.l_i * g.w_i.cross(g.n) : (g.l_i * g.w_i - g.l_j * g.w_j).cross(g.n);
   }
 
   // The spring-slider; the moment on i is g.l_ij * n x force.
-  SpringSlider evaluate(const ContactGeometry& g, double normal_force,
-                        const Eigen::Vector3d& spring, double dt) const {
+  GRANMEM_INLINE SpringSlider evaluate(const ContactGeometry& g, double normal_force,
+                                       const Eigen::Vector3d& spring, double dt) const {
     return spring_slider(spring, g.n, velocity(g), dt, k,
                          damping_per_sqrt_mass * g.sqrt_reduced_mass,
                          cap_per_normal_force * std::abs(normal_force));

@@ -116,6 +116,7 @@ class Simulation {
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
   std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
   WallLoads wall_loads_;
+  double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass
   double time_ = 0;
   std::int64_t step_count_ = 0;
 };

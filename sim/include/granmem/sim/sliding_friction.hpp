@@ -5,17 +5,23 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/inline.hpp"
 
 namespace granmem {
 
 // Keeps a contact spring in the current tangent plane: the part along n is removed and the
 // length kept, so that a contact turning as a whole neither gains nor loses spring energy.
-inline Eigen::Vector3d onto_tangent_plane(const Eigen::Vector3d& spring, const Eigen::Vector3d& n) {
-  const double length_sq = spring.squaredNorm();
-  if (length_sq == 0) return spring;
-  const Eigen::Vector3d t = spring - spring.dot(n) * n;
+GRANMEM_INLINE Eigen::Vector3d onto_tangent_plane(const Eigen::Vector3d& spring,
+                                                  const Eigen::Vector3d& n) {
+  const double along = spring.dot(n);
+  if (along == 0) return spring;
+  const Eigen::Vector3d t = spring - along * n;
   const double t_sq = t.squaredNorm();
-  return t_sq > 0 ? Eigen::Vector3d(t * std::sqrt(length_sq / t_sq)) : Eigen::Vector3d::Zero();
+  if (t_sq == 0) return Eigen::Vector3d::Zero();
+  // Length kept: scale by sqrt(1 + along^2 / t^2). A contact turns little in one step, and
+  // below 1e-8 the first order term is exact to double precision.
+  const double ratio = along * along / t_sq;
+  return t * (ratio < 1e-8 ? 1.0 + 0.5 * ratio : std::sqrt(1.0 + ratio));
 }
 
 // A spring-dashpot capped by a Coulomb slider: F = -k s - C v, |F| <= cap. Where it slips,
@@ -24,9 +30,9 @@ struct SpringSlider {
   Eigen::Vector3d force;
   Eigen::Vector3d spring;  // history after this step
 };
-inline SpringSlider spring_slider(const Eigen::Vector3d& spring_before, const Eigen::Vector3d& n,
-                                  const Eigen::Vector3d& velocity, double dt, double k, double c,
-                                  double cap) {
+GRANMEM_INLINE SpringSlider spring_slider(const Eigen::Vector3d& spring_before,
+                                          const Eigen::Vector3d& n, const Eigen::Vector3d& velocity,
+                                          double dt, double k, double c, double cap) {
   SpringSlider out;
   out.spring = onto_tangent_plane(spring_before, n) + velocity * dt;
   out.force = -k * out.spring - c * velocity;
@@ -51,8 +57,8 @@ struct SlidingFriction {
         damping_per_sqrt_mass(dashpot_coefficient(p.k_t(), p.restitution_t, 1.0)),
         mu(mu_s) {}
 
-  SpringSlider evaluate(const ContactGeometry& g, double normal_force,
-                        const Eigen::Vector3d& spring, double dt) const {
+  GRANMEM_INLINE SpringSlider evaluate(const ContactGeometry& g, double normal_force,
+                                       const Eigen::Vector3d& spring, double dt) const {
     return spring_slider(spring, g.n, g.v_t, dt, k, damping_per_sqrt_mass * g.sqrt_reduced_mass,
                          mu * std::abs(normal_force));
   }

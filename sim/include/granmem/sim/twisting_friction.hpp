@@ -4,6 +4,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
+#include "granmem/sim/inline.hpp"
 
 namespace granmem {
 
@@ -25,13 +26,16 @@ struct TwistingFriction {
                               2.0),
         cap_per_normal_force(mu_t * mu_s * p.beta) {}
 
-  static double velocity(const ContactGeometry& g) { return g.l_ij * (g.w_i - g.w_j).dot(g.n); }
+  GRANMEM_INLINE static double velocity(const ContactGeometry& g) {
+    return g.l_ij * (g.w_i - g.w_j).dot(g.n);
+  }
 
   struct Result {
     double force = 0;   // the moment on i is l_ij * force * n
     double spring = 0;  // history after this step
   };
-  Result evaluate(const ContactGeometry& g, double normal_force, double spring, double dt) const {
+  GRANMEM_INLINE Result evaluate(const ContactGeometry& g, double normal_force, double spring,
+                                 double dt) const {
     const double v = velocity(g);
     const double c = damping_per_sqrt_mass * g.sqrt_reduced_mass;
     const double cap = cap_per_normal_force * std::abs(normal_force);

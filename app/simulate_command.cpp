@@ -139,7 +139,7 @@ void add_simulate(CLI::App& app) {
       ->check(CLI::ExistingFile);
 
   cmd->callback([args, threads, resume, given] {
-    if (*threads > 0) omp_set_num_threads(*threads);
+    if (*threads > 0) omp_set_num_threads(*threads);  // deposit's and the cycles' simulations
     std::signal(SIGINT, request_stop);
     std::map<std::string, std::string> v = args->value;
     ProtocolState state;
@@ -196,6 +196,7 @@ void add_simulate(CLI::App& app) {
       state.settings = v;
     }
 
+    sim->set_threads(*threads);  // 0: by the number of grains
     CyclicOptions c;
     c.cycles = whole(v, "cycles");
     const std::string& amplitude = v.at("amplitude");

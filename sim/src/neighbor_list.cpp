@@ -78,7 +78,7 @@ void NeighborList::build(const Grains& g) {
     }
   };
   std::vector<std::uint32_t> count(n, 0);
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t c = 0;
     visit(i, [&](std::uint32_t) { ++c; });
@@ -88,7 +88,7 @@ void NeighborList::build(const Grains& g) {
     offset_[i + 1] = offset_[i] + count[i];
   partner_.resize(offset_[n]);
   owner_.resize(offset_[n]);
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     std::uint32_t k = offset_[i];
     visit(i, [&](std::uint32_t j) {
@@ -109,7 +109,7 @@ void NeighborList::build(const Grains& g) {
     for (std::uint32_t k = 0; k < partner_.size(); ++k)
       incoming_[fill[partner_[k]]++] = k;
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     std::sort(incoming_.begin() + incoming_offset_[i], incoming_.begin() + incoming_offset_[i + 1],
               [&](std::uint32_t a, std::uint32_t b) { return g.id[owner_[a]] < g.id[owner_[b]]; });
@@ -120,7 +120,7 @@ bool NeighborList::stale(const Grains& g) const {
   if (built_at_.size() != g.size()) return true;
   const double limit_sq = 0.25 * skin_ * skin_;
   bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved)
+#pragma omp parallel for schedule(static) reduction(|| : moved) num_threads(threads_)
   for (std::size_t i = 0; i < g.size(); ++i) {
     moved = moved || (g.x[i] - built_at_[i]).squaredNorm() > limit_sq;
   }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include <omp.h>
+
 #include "granmem/core/error.hpp"
 
 namespace granmem {
@@ -68,6 +70,7 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
   const double r_min =
       grains_.size() ? *std::min_element(grains_.radius.begin(), grains_.radius.end()) : 1.0;
   physics_.validate("simulation", r_min);
+  set_threads(0);
   if (!grains_.mass.empty() && std::all_of(grains_.mass.begin(), grains_.mass.end(),
                                            [&](double m) { return m == grains_.mass.front(); })) {
     uniform_sqrt_reduced_mass_ = sqrt_reduced_mass(grains_.mass.front(), grains_.mass.front());
@@ -79,8 +82,18 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
   refresh_forces();
 }
 
+void Simulation::set_threads(int threads) {
+  // Threads pay for their barriers only with enough grains each (and a thread spinning at a
+  // barrier on a busy core can stall a small run for a whole time slice).
+  threads_ = threads > 0
+                 ? threads
+                 : std::clamp(int(grains_.size() / kGrainsPerThread), 1, omp_get_max_threads());
+  neighbors_.set_threads(threads_);
+}
+
 void Simulation::rebuild_neighbors() {
   NeighborList next(physics_.skin);
+  next.set_threads(threads_);
   next.build(grains_);
   pair_history_ = next.carry(neighbors_, pair_history_, grains_.id, ContactHistory{});
   touching_ = next.carry(neighbors_, touching_, grains_.id, std::uint8_t{0});
@@ -100,7 +113,7 @@ void Simulation::compute_forces(bool commit) {
   Grains& g = grains_;
 
   // Grain pairs: each evaluated once, by its owner.
-#pragma omp parallel for schedule(dynamic, 128)
+#pragma omp parallel for schedule(dynamic, 128) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d xi = g.x[i];
     const double ri = g.radius[i];
@@ -138,7 +151,7 @@ void Simulation::compute_forces(bool commit) {
   std::array<Container::Plane, kWallCount> planes;
   for (int w = 0; w < walls; ++w)
     planes[w] = container_.plane(static_cast<Wall>(w));
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     Eigen::Vector3d f = g.mass[i] * gravity, t = Eigen::Vector3d::Zero();
     if (drag > 0) {
@@ -201,7 +214,7 @@ void Simulation::step() {
   Grains& g = grains_;
   const std::size_t n = g.size();
   bool stale = false;
-#pragma omp parallel for schedule(static) reduction(|| : stale)
+#pragma omp parallel for schedule(static) reduction(|| : stale) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     g.v[i] += half * g.inv_mass[i] * g.force[i];
     g.w[i] += half * g.inv_inertia[i] * g.torque[i];
@@ -223,7 +236,7 @@ void Simulation::step() {
 
   compute_forces(true);
 
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     g.v[i] += half * g.inv_mass[i] * g.force[i];
     g.w[i] += half * g.inv_inertia[i] * g.torque[i];
@@ -268,6 +281,7 @@ void Simulation::restore(double time, std::int64_t steps, const std::vector<Pair
   for (std::size_t i = 0; i < grains_.size(); ++i)
     index[grains_.id[i]] = std::uint32_t(i);
   neighbors_ = NeighborList(physics_.skin);
+  neighbors_.set_threads(threads_);
   rebuild_neighbors();
   std::fill(pair_history_.begin(), pair_history_.end(), ContactHistory{});
   std::fill(touching_.begin(), touching_.end(), 0);

@@ -27,6 +27,7 @@ class NeighborList {
   }
 
   double skin() const { return skin_; }
+  void set_threads(int threads) { threads_ = threads; }
   std::size_t pair_count() const { return partner_.size(); }
   // Pairs owned by grain i: indices [begin(i), end(i)) into partner().
   std::uint32_t begin(std::size_t i) const { return offset_[i]; }
@@ -47,6 +48,7 @@ class NeighborList {
 
  private:
   double skin_;
+  int threads_ = 1;
   std::vector<std::uint32_t> offset_, partner_, owner_;
   std::vector<std::uint32_t> incoming_offset_, incoming_;
   std::vector<Eigen::Vector3d> built_at_;
@@ -58,7 +60,7 @@ std::vector<T> NeighborList::carry(const NeighborList& before, const std::vector
   std::vector<T> out(partner_.size(), fresh);
   if (before.offset_.size() != offset_.size()) return out;  // a different set of grains
   const std::size_t n = offset_.size() - 1;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
     // Both lists of grain i are sorted by partner id: a merge finds the common pairs.
     std::uint32_t a = before.offset_[i];

@@ -64,6 +64,12 @@ class Simulation {
   void step();
   void run(std::int64_t steps);
 
+  // OpenMP threads: 0 (the default) uses one per 2,500 grains, up to omp_get_max_threads(),
+  // since smaller shares do not pay for a thread's barriers; a positive count is used as is.
+  // Results are the same for any count.
+  void set_threads(int threads);
+  int threads() const { return threads_; }
+
   double time() const { return time_; }
   std::int64_t step_count() const { return step_count_; }
   const Grains& grains() const { return grains_; }
@@ -116,6 +122,8 @@ class Simulation {
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
   std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
   WallLoads wall_loads_;
+  static constexpr std::size_t kGrainsPerThread = 2500;
+  int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass
   double time_ = 0;
   std::int64_t step_count_ = 0;

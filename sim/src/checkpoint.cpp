@@ -124,6 +124,14 @@ void write_checkpoint(const std::filesystem::path& path, const Simulation& sim,
                              {"lid_v", c.lid.v},
                              {"lid_force", c.lid.force}}));
     h5::write_table(f.id(), "/checkpoint/physics", scalars(physics_values(sim.physics())));
+    std::map<std::string, double> loads;
+    for (int w = 0; w < kWallCount; ++w) {
+      const std::string wall = "wall" + std::to_string(w);
+      for (int d = 0; d < 3; ++d)
+        loads[wall + "_f" + "xyz"[d]] = sim.wall_loads().force[w][d];
+      loads[wall + "_contacts"] = sim.wall_loads().contacts[w];
+    }
+    h5::write_table(f.id(), "/checkpoint/wall_loads", scalars(loads));
     h5::write_table(f.id(), "/checkpoint/clock",
                     scalars({{"time", sim.time()}, {"steps", double(sim.step_count())}}));
 
@@ -267,9 +275,18 @@ Simulation read_checkpoint(const std::filesystem::path& path, ProtocolState* pro
     }
   }
 
+  const Table load_table = h5::read_table(f, "/checkpoint/wall_loads");
+  WallLoads loads;
+  for (int wall = 0; wall < kWallCount; ++wall) {
+    const std::string name = "wall" + std::to_string(wall);
+    for (int d = 0; d < 3; ++d) {
+      loads.force[wall][d] = scalar(load_table, name + "_f" + "xyz"[d], where);
+    }
+    loads.contacts[wall] = int(scalar(load_table, name + "_contacts", where));
+  }
   Simulation sim(std::move(grains), c, physics);
   sim.restore(scalar(clock, "time", where), std::int64_t(scalar(clock, "steps", where)), pairs,
-              std::move(walls));
+              std::move(walls), loads);
   // The forces of the last step, exactly as they were: the next half-kick uses them.
   sim.grains().force = force;
   sim.grains().torque = torque;

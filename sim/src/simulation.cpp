@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <unordered_map>
 
 #include <omp.h>
@@ -71,6 +72,10 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
       grains_.size() ? *std::min_element(grains_.radius.begin(), grains_.radius.end()) : 1.0;
   physics_.validate("simulation", r_min);
   set_threads(0);
+  by_id_.resize(grains_.size());
+  std::iota(by_id_.begin(), by_id_.end(), std::size_t{0});
+  std::sort(by_id_.begin(), by_id_.end(),
+            [&](std::size_t a, std::size_t b) { return grains_.id[a] < grains_.id[b]; });
   if (!grains_.mass.empty() && std::all_of(grains_.mass.begin(), grains_.mass.end(),
                                            [&](double m) { return m == grains_.mass.front(); })) {
     uniform_sqrt_reduced_mass_ = sqrt_reduced_mass(grains_.mass.front(), grains_.mass.front());
@@ -192,9 +197,9 @@ void Simulation::compute_forces(bool commit) {
     g.torque[i] = t;
   }
 
-  // Loads on the walls, summed in grain order (the lid's motion depends on them).
+  // Loads on the walls, summed in the order of grain ids (the lid's motion depends on them).
   wall_loads_ = WallLoads{};
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i : by_id_) {
     if (!wall_touch_[i]) continue;
     for (int w = 0; w < walls; ++w) {
       if (wall_touch_[i] & (1u << w)) {
@@ -269,7 +274,8 @@ std::vector<Simulation::PairRecord> Simulation::pair_histories() const {
 }
 
 void Simulation::restore(double time, std::int64_t steps, const std::vector<PairRecord>& pairs,
-                         std::vector<std::array<ContactHistory, kWallCount>> walls) {
+                         std::vector<std::array<ContactHistory, kWallCount>> walls,
+                         const WallLoads& loads) {
   if (walls.size() != grains_.size()) {
     throw Error("checkpoint: wall histories for " + std::to_string(walls.size()) +
                 " grains, the state has " + std::to_string(grains_.size()));
@@ -306,6 +312,10 @@ void Simulation::restore(double time, std::int64_t steps, const std::vector<Pair
                   std::to_string(p.id_b) + " are in contact but not neighbours");
     }
   }
+  // Histories are committed every step, so the pairs that have one are those that touched
+  // at the last step.
+  active_ = touching_;
+  wall_loads_ = loads;
 }
 
 }  // namespace granmem

@@ -93,9 +93,10 @@ class Simulation {
   const std::vector<std::array<ContactHistory, kWallCount>>& wall_histories() const {
     return wall_history_;
   }
-  // Restores a checkpoint's state: time, step, and the histories above.
+  // Restores a checkpoint's state: time, step, the histories above, and the wall loads of
+  // the last step.
   void restore(double time, std::int64_t steps, const std::vector<PairRecord>& pairs,
-               std::vector<std::array<ContactHistory, kWallCount>> walls);
+               std::vector<std::array<ContactHistory, kWallCount>> walls, const WallLoads& loads);
   // Sets the forces and torques for the first half-kick without touching any history;
   // called by the constructor, and after grains or walls are moved by hand.
   void refresh_forces();
@@ -122,6 +123,7 @@ class Simulation {
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
   std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
   WallLoads wall_loads_;
+  std::vector<std::size_t> by_id_;  // grain indices in increasing id
   static constexpr std::size_t kGrainsPerThread = 2500;
   int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass

@@ -672,5 +672,134 @@ TEST_F(TrajectoryStore, OtherInconsistenciesAreErrors) {
       << msg;
 }
 
+// publish(): a complete, readable copy of what is written so far goes into place, and the
+// writer goes on; the final commit() gives the same run as a writer that never published.
+TEST_F(TrajectoryStore, PublishedFileIsCompleteAndReadableWhileWritingGoesOn) {
+  const Trajectories run = random_run(11, 6, 5);
+  fs::create_directories(path("a"));
+  fs::create_directories(path("b"));
+  const fs::path p = path("a/run.h5"), whole = path("b/run.h5");
+  write_trajectories(whole, run);
+  TrajectoryWriter w(p, run.header);
+  // The observables measured up to each frame.
+  auto observables_until = [&](std::size_t frames) {
+    std::map<std::string, Observable> out;
+    for (const auto& [name, obs] : run.observables) {
+      Observable o;
+      o.unit = obs.unit;
+      for (std::size_t k = 0; k < obs.value.size(); ++k) {
+        if (obs.step[k] > run.frames[frames - 1].step) continue;
+        o.value.push_back(obs.value[k]);
+        o.step.push_back(obs.step[k]);
+        o.time.push_back(obs.time[k]);
+      }
+      out[name] = o;
+    }
+    return out;
+  };
+  for (std::size_t t = 0; t < run.frames.size(); ++t) {
+    w.append(run.frames[t]);
+    if (t != 1 && t != 4) continue;
+    for (const auto& [name, obs] : observables_until(t + 1))
+      w.set_observable(name, obs);
+    w.publish();
+    // The file in place holds exactly the frames so far, and opens in ParaView.
+    Trajectories part = run;
+    part.frames.resize(t + 1);
+    part.observables = observables_until(t + 1);
+    expect_same_run(part, read_trajectories(p));
+    EXPECT_TRUE(fs::exists(xdmf_path(p)));
+    EXPECT_EQ(count(read_text(xdmf_path(p)), "<Grid Name=\"step "), t + 1);
+  }
+  for (const auto& [name, obs] : run.observables)
+    w.set_observable(name, obs);
+  w.commit();
+  expect_same_run(run, read_trajectories(p));
+  EXPECT_EQ(read_text(xdmf_path(p)), read_text(xdmf_path(whole)));
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(path("a")))
+    left.push_back(e.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"run.h5", "run.xmf"})) << "temporary files left";
+}
+
+// resume(path, k) keeps exactly the first k frames and the observables of steps up to the k-th
+// frame's; appending the rest and committing gives the run written in one go.
+TEST_F(TrajectoryStore, ResumedRunKeepsItsFirstFramesAndEndsAsAnUninterruptedOne) {
+  const Trajectories run = random_run(12, 6, 5);  // frame steps -3, 7, 17, 27, 37, 47
+  fs::create_directories(path("a"));
+  fs::create_directories(path("b"));
+  const fs::path p = path("a/run.h5"), whole = path("b/run.h5");
+  write_trajectories(whole, run);
+  for (std::size_t keep : {0u, 3u, 6u}) {
+    SCOPED_TRACE("keep " + std::to_string(keep));
+    write_trajectories(p, run);
+    const std::string before = read_text(p);
+    TrajectoryWriter w = TrajectoryWriter::resume(p, keep);
+    EXPECT_EQ(w.frame_count(), keep);
+    expect_same_header(run.header, w.header());
+    // Observables: those of steps up to the last kept frame's.
+    const std::int64_t last =
+        keep ? run.frames[keep - 1].step : std::numeric_limits<std::int64_t>::min();
+    for (const auto& [name, obs] : run.observables) {
+      const Observable& kept = w.observables().at(name);
+      std::vector<std::int64_t> steps;
+      for (std::int64_t s : obs.step) {
+        if (s <= last) steps.push_back(s);
+      }
+      EXPECT_EQ(kept.step, steps) << name;
+      EXPECT_EQ(kept.unit, obs.unit) << name;
+      ASSERT_EQ(kept.value.size(), steps.size()) << name;
+      EXPECT_TRUE(same_bits(kept.value.data(), obs.value.data(), steps.size(), name));
+    }
+    EXPECT_EQ(read_text(p), before) << "the file changed before publish() or commit()";
+    for (std::size_t t = keep; t < run.frames.size(); ++t)
+      w.append(run.frames[t]);
+    for (const auto& [name, obs] : run.observables)
+      w.set_observable(name, obs);
+    w.commit();
+    expect_same_run(run, read_trajectories(p));
+    EXPECT_EQ(read_text(xdmf_path(p)), read_text(xdmf_path(whole)));
+  }
+  // Observables of the steps kept, explicitly: lid_height has steps 0, 100, 200, and the
+  // third frame is step 17.
+  write_trajectories(p, run);
+  const TrajectoryWriter w = TrajectoryWriter::resume(p, 3);
+  EXPECT_EQ(w.observables().at("lid_height").step, (std::vector<std::int64_t>{0}));
+  EXPECT_EQ(w.observables().at("wall_force").step, (std::vector<std::int64_t>{-3, 7, 17}));
+}
+
+TEST_F(TrajectoryStore, PublishedRunLeftUnfinishedCanBeResumed) {
+  const Trajectories run = random_run(13, 6, 5);
+  fs::create_directories(path("a"));
+  fs::create_directories(path("b"));
+  const fs::path p = path("a/run.h5"), whole = path("b/run.h5");
+  write_trajectories(whole, run);
+  {
+    TrajectoryWriter w(p, run.header);
+    for (std::size_t t = 0; t < 4; ++t)
+      w.append(run.frames[t]);
+    w.publish();
+    w.append(run.frames[4]);  // lost: the writer is dropped without publishing again
+  }
+  EXPECT_EQ(read_trajectories(p).frames.size(), 4u);
+  TrajectoryWriter w = TrajectoryWriter::resume(p, 2);
+  for (std::size_t t = 2; t < run.frames.size(); ++t)
+    w.append(run.frames[t]);
+  for (const auto& [name, obs] : run.observables)
+    w.set_observable(name, obs);
+  w.commit();
+  expect_same_run(run, read_trajectories(p));
+  EXPECT_EQ(read_text(xdmf_path(p)), read_text(xdmf_path(whole)));
+}
+
+TEST_F(TrajectoryStore, ResumingAfterMoreFramesThanTheFileHoldsIsAnError) {
+  const fs::path p = good_store();  // 4 frames
+  const std::string msg = error_message([&] { TrajectoryWriter::resume(p, 5); });
+  EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("has 4 frames"), std::string::npos) << msg;
+  EXPECT_THROW(TrajectoryWriter::resume(path("missing.h5"), 0), Error);
+}
+
 }  // namespace
 }  // namespace granmem

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "granmem/sim/simulation.hpp"
 
@@ -56,22 +57,39 @@ TEST(TwoGrainCollision, HeadOnRestitutionAndDurationMatchTheDampedSpring) {
   }
 }
 
+// While it slides, Coulomb friction mu m g decelerates it at mu g and spins it up at
+// (5/2) mu g / R; sliding stops when v = R w, at t* = 2 v0 / (7 mu g), at v = 5/7 v0
+// (angular momentum about the contact point is conserved). Then it rolls on.
 TEST(TwoGrainCollision, SlidingGrainRollsAtFiveSeventhsOfItsSpeed) {
   PhysicsOptions p;
   p.contact.mu_r = 0;  // pure Coulomb sliding: the classic 5/7
   p.contact.mu_t = 0;
-  p.wall = {0.3, 0, 0};
+  const double mu = 0.3, v0 = 0.2, g_acc = 9.81;
+  p.wall = {mu, 0, 0};
   Grains g;
   const double r = kRadius;
   g.add(0, {1, 1, r - 9.81 * 7.72e-5 / 4000}, r, kDensity);  // resting on its overlap
-  g.v[0] = {0.2, 0, 0};
+  g.v[0] = {v0, 0, 0};
   Container c;
   c.size = {10, 10};
   Simulation sim(g, c, p);
-  sim.run(40000);  // 1 s: sliding stops after 2 v0 / (7 mu g) ~ 0.02 s
+  const double t_star = 2 * v0 / (7 * mu * g_acc);  // 0.0194 s
+  double slip_ends = -1;
+  for (int s = 0; s < 8000; ++s) {  // 0.2 s
+    sim.step();
+    const Grains& now = sim.grains();
+    if (s == 399) {  // t = 0.01 s, sliding
+      EXPECT_NEAR(now.v[0].x(), v0 - mu * g_acc * 0.01, 1e-3 * v0);
+      EXPECT_NEAR(now.w[0].y() * r, 2.5 * mu * g_acc * 0.01, 1e-3 * v0);
+    }
+    if (slip_ends < 0 && now.v[0].x() - now.w[0].y() * r < 1e-4 * v0) slip_ends = sim.time();
+  }
+  EXPECT_NEAR(slip_ends, t_star, 0.02 * t_star);
+  RecordProperty("slip_ends_measured", std::to_string(slip_ends));
+  RecordProperty("slip_ends_expected", std::to_string(t_star));
   const Grains& s = sim.grains();
-  EXPECT_NEAR(s.v[0].x(), 5.0 / 7.0 * 0.2, 2e-3 * 0.2);
-  EXPECT_NEAR(s.w[0].y() * r, s.v[0].x(), 2e-3 * 0.2);  // rolling without slipping
+  EXPECT_NEAR(s.v[0].x(), 5.0 / 7.0 * v0, 2e-3 * v0);
+  EXPECT_NEAR(s.w[0].y() * r, s.v[0].x(), 2e-3 * v0);  // rolling without slipping
 }
 
 TEST(TwoGrainCollision, EnergyIsConservedWithoutDampingOrFriction) {

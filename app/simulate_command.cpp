@@ -168,17 +168,61 @@ void add_simulate(CLI::App& app) {
       v["checkpoint"] = checkpoint;
     }
 
+    DepositOptions d;
+    d.grains = whole(v, "grains");
+    d.radius = radius;
+    d.polydispersity = number(v, "polydispersity");
+    d.box_side = box;
+    d.lid_mass = si(v, "lid-mass", Dimension::mass);
+    d.seed = std::uint64_t(whole(v, "seed"));
+    d.settled_energy = si(v, "settled-energy", Dimension::energy);
+    d.settling_damping = number(v, "settling-damping");
+    physics.validate("simulate", d.radius * (1 - d.polydispersity));
+    const double box_y = sim ? sim->container().size.y() : box;
+    const double lid_mass =
+        sim ? (sim->container().lid.present ? sim->container().lid.mass : 0) : d.lid_mass;
+
+    // Every setting is checked before the packing is made.
+    CyclicOptions c;
+    c.cycles = whole(v, "cycles");
+    const std::string& amplitude = v.at("amplitude");
+    c.drive.amplitude =
+        !amplitude.empty() && amplitude.back() == '%'
+            ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") /
+                  100 * box_y
+            : si(v, "amplitude", Dimension::length);
+    c.drive.symmetry = parse_drive_symmetry(v.at("drive"));
+    c.drive.shape = parse_drive_shape(v.at("wall-motion"));
+    if (v.at("period") == "auto") {
+      // Under the lid the confining pressure is its weight over the box; the lateral stress
+      // just beneath it, about half that, is the smallest in the packing. Without a lid, the
+      // weight of one layer of grains.
+      const double pressure = lid_mass > 0 ? lid_mass * physics.gravity / (box * box)
+                                           : physics.density * 0.6 * physics.gravity * 2 * radius;
+      const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_y, 2 * radius,
+                                                   0.5 * pressure, physics.density);
+      c.drive.period =
+          WallDrive::period_for_speed(c.drive.amplitude, speed, c.drive.symmetry, c.drive.shape);
+    } else {
+      c.drive.period = si(v, "period", Dimension::time);
+    }
+    c.out = out;
+    c.full_compression_frames = v.at("full-compression") == "true";
+    std::stringstream track(v.at("track"));
+    for (std::string id; std::getline(track, id, ',');) {
+      if (id.empty()) continue;
+      const Quantity q = parse_quantity(id, "--track");
+      if (!q.unit.empty() || q.value != std::floor(q.value)) {
+        throw Error("--track '" + v.at("track") + "': expected grain ids, e.g. 3,17,250");
+      }
+      c.tracked_grains.push_back(std::int64_t(q.value));
+    }
+    c.samples_per_cycle = whole(v, "samples-per-cycle");
+    c.checkpoint = checkpoint;
+    c.checkpoint_every = whole(v, "checkpoint-every");
+    c.validate(box_y, physics.dt);
+
     if (!sim) {
-      DepositOptions d;
-      d.grains = whole(v, "grains");
-      d.radius = radius;
-      d.polydispersity = number(v, "polydispersity");
-      d.box_side = box;
-      d.lid_mass = si(v, "lid-mass", Dimension::mass);
-      d.seed = std::uint64_t(whole(v, "seed"));
-      d.settled_energy = si(v, "settled-energy", Dimension::energy);
-      d.settling_damping = number(v, "settling-damping");
-      physics.validate("simulate", d.radius * (1 - d.polydispersity));
       std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
       DepositSummary s;
       double last = -1;
@@ -195,42 +239,7 @@ void add_simulate(CLI::App& app) {
                 << s.lid_height * 100 << " cm, " << s.contacts_per_grain << " contacts per grain\n";
       state.settings = v;
     }
-
     sim->set_threads(*threads);  // 0: by the number of grains
-    CyclicOptions c;
-    c.cycles = whole(v, "cycles");
-    const std::string& amplitude = v.at("amplitude");
-    c.drive.amplitude =
-        !amplitude.empty() && amplitude.back() == '%'
-            ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") /
-                  100 * sim->container().size.y()
-            : si(v, "amplitude", Dimension::length);
-    c.drive.symmetry = parse_drive_symmetry(v.at("drive"));
-    c.drive.shape = parse_drive_shape(v.at("wall-motion"));
-    if (v.at("period") == "auto") {
-      // Under the lid the confining pressure is its weight over the box; the lateral stress
-      // just beneath it, about half that, is the smallest in the packing.
-      const Container& box_now = sim->container();
-      const double lid_pressure =
-          box_now.lid.present
-              ? box_now.lid.mass * physics.gravity / (box_now.size.x() * box_now.size.y())
-              : physics.density * 0.6 * physics.gravity * 2 * radius;
-      const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_now.size.y(),
-                                                   2 * radius, 0.5 * lid_pressure, physics.density);
-      c.drive.period =
-          WallDrive::period_for_speed(c.drive.amplitude, speed, c.drive.symmetry, c.drive.shape);
-    } else {
-      c.drive.period = si(v, "period", Dimension::time);
-    }
-    c.out = out;
-    c.full_compression_frames = v.at("full-compression") == "true";
-    std::stringstream track(v.at("track"));
-    for (std::string id; std::getline(track, id, ',');) {
-      if (!id.empty()) c.tracked_grains.push_back(std::stoll(id));
-    }
-    c.samples_per_cycle = whole(v, "samples-per-cycle");
-    c.checkpoint = checkpoint;
-    c.checkpoint_every = whole(v, "checkpoint-every");
     for (const auto& [key, value] : v)
       c.parameters["simulate/" + key] = value;
     const double steps_per_cycle = std::round(c.drive.period / physics.dt);

@@ -73,20 +73,28 @@ struct Output {
 
 }  // namespace
 
+void CyclicOptions::validate(double box_y, double dt) const {
+  if (cycles < 1) throw Error("cycles: at least one cycle is needed");
+  if (!(drive.amplitude > 0)) throw Error("amplitude: must be positive");
+  if (drive.amplitude >= 0.5 * box_y) {
+    throw Error("amplitude " + std::to_string(drive.amplitude) +
+                " m: must be less than half the box (" + std::to_string(box_y) + " m)");
+  }
+  if (!(std::llround(drive.period / dt) >= 4)) {
+    throw Error("cycle period: shorter than four time steps");
+  }
+  if (samples_per_cycle < 0 || checkpoint_every < 0) {
+    throw Error("samples per cycle and checkpoint interval must be zero or positive");
+  }
+}
+
 CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState& state,
                          const std::function<void(const CyclicProgress&)>& progress,
                          const std::atomic<bool>* stop) {
   const double dt = sim.physics().dt;
   const WallDrive& drive = o.drive;
-  if (o.cycles < 1) throw Error("cycles: at least one cycle is needed");
-  if (!(drive.amplitude > 0)) throw Error("amplitude: must be positive");
-  if (drive.amplitude >= 0.5 * sim.container().size.y()) {
-    throw Error("amplitude " + std::to_string(drive.amplitude) +
-                " m: must be less than half the box (" + std::to_string(sim.container().size.y()) +
-                " m)");
-  }
+  o.validate(sim.container().size.y(), dt);
   const auto steps_per_cycle = std::llround(drive.period / dt);
-  if (steps_per_cycle < 4) throw Error("cycle period: shorter than four time steps");
   const auto full_step = std::llround(drive.full_compression_time() / dt);
   const std::int64_t sample_every =
       o.samples_per_cycle > 0 ? std::max<std::int64_t>(1, steps_per_cycle / o.samples_per_cycle)

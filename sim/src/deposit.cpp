@@ -59,8 +59,7 @@ double settle(Simulation& sim, const DepositOptions& o, const std::string& stage
 
 }  // namespace
 
-Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, DepositSummary* summary,
-                   const DepositProgress& progress) {
+Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
   if (o.grains < 1) throw Error("deposit: needs at least one grain");
   if (!(o.radius > 0)) throw Error("deposit: grain radius must be positive");
   if (!(o.polydispersity >= 0 && o.polydispersity < 1)) {
@@ -92,6 +91,12 @@ Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, Depos
     Eigen::Quaterniond q(random.normal(), random.normal(), random.normal(), random.normal());
     grains.q.back() = q.normalized();
   }
+  return grains;
+}
+
+Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, DepositSummary* summary,
+                   const DepositProgress& progress) {
+  Grains grains = insert_grains(o, physics);
   Container box;
   box.size = {o.box_side, o.box_side};
 

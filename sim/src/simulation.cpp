@@ -208,9 +208,10 @@ void Simulation::compute_forces(bool commit) {
       }
     }
   }
-  if (container_.lid.present) {
-    container_.lid.force =
-        wall_loads_.force[int(Wall::lid)].z() - container_.lid.mass * physics_.gravity;
+  Lid& lid = container_.lid;
+  if (lid.present) {
+    lid.force = wall_loads_.force[int(Wall::lid)].z() - lid.mass * physics_.gravity -
+                drag * lid.mass * lid.v;
   }
 }
 

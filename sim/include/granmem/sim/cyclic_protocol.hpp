@@ -27,6 +27,10 @@ struct CyclicOptions {
   std::filesystem::path checkpoint;               // where checkpoints go; empty: none
   std::int64_t checkpoint_every = 0;              // cycles between checkpoints; 0: at the end only
   std::map<std::string, std::string> parameters;  // written into the outputs' /parameters
+
+  // Throws Error for settings no run can use in a box of this depth along y with this step
+  // (amplitude of half the box or more, no cycles, a period under four steps).
+  void validate(double box_y, double dt) const;
 };
 
 struct CyclicProgress {

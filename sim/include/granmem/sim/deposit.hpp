@@ -39,6 +39,12 @@ using DepositProgress = std::function<void(const std::string& stage, double time
 Simulation deposit(const DepositOptions& options, const PhysicsOptions& physics,
                    DepositSummary* summary = nullptr, const DepositProgress& progress = {});
 
+// The grains as deposit() inserts them, before anything moves: positions on the jittered
+// lattice, radii, random velocities and orientations drawn from `options.seed`. deposit()
+// starts from exactly these, so other codes can be started from the same state.
+// Throws Error for the options and physics deposit() rejects.
+Grains insert_grains(const DepositOptions& options, const PhysicsOptions& physics);
+
 // Volume fraction of grains under the lid (or under the highest grain top without one),
 // between the driven wall and the far wall.
 double packing_fraction(const Simulation& sim);

@@ -30,8 +30,8 @@ struct PhysicsOptions {
   double gravity = 9.81;    // m/s^2, along -z
   double dt = 25e-6;        // s
   double skin = 5e-4;       // neighbour-list skin, m
-  // Drag -rate m v and -rate I w on every grain, 1/s. Only to speed up settling; 0 while
-  // driven.
+  // Drag -rate m v and -rate I w on every grain (and -rate M v on the lid), 1/s. Only to
+  // speed up settling; 0 while driven.
   double background_damping = 0;
   // Fewest time steps a collision must last; see validate().
   double min_steps_per_collision = 10;
@@ -81,7 +81,11 @@ class Simulation {
   const WallLoads& wall_loads() const { return wall_loads_; }
   // Grain-grain contacts at the last step.
   std::size_t contact_count() const;
-  double kinetic_energy() const { return grains_.kinetic_energy(); }
+  // Of the grains and the lid.
+  double kinetic_energy() const {
+    const Lid& lid = container_.lid;
+    return grains_.kinetic_energy() + (lid.present ? 0.5 * lid.mass * lid.v * lid.v : 0.0);
+  }
 
   // Contact history, for checkpoints: every touching grain pair as (id, id, history), and
   // each grain's history against each wall.

@@ -83,6 +83,7 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
   wall_history_.assign(grains_.size(), {});
   wall_force_on_grain_.assign(grains_.size(), {});
   wall_touch_.assign(grains_.size(), 0);
+  wall_remembered_.assign(grains_.size(), 0);
   rebuild_neighbors();
   refresh_forces();
 }
@@ -175,12 +176,15 @@ void Simulation::compute_forces(bool commit) {
       t += pair_force_[k].torque_on_i;
     }
     std::uint8_t touch = 0;
+    const std::uint8_t remembered = wall_remembered_[i];
     for (int w = 0; w < walls; ++w) {
       const Container::Plane& p = planes[w];
       const double distance = p.normal.dot(g.x[i]) - p.offset;
       ContactHistory& history = wall_history_[i][w];
       if (distance >= g.radius[i]) {
-        if (commit) history = ContactHistory{};
+        // Forget a broken contact's springs (only where there are some: this loop runs for
+        // every grain and wall each step).
+        if (commit && (remembered & (1u << w))) history = ContactHistory{};
         continue;
       }
       const ContactGeometry geometry =
@@ -193,6 +197,7 @@ void Simulation::compute_forces(bool commit) {
       touch |= std::uint8_t(1u << w);
     }
     wall_touch_[i] = touch;
+    if (commit) wall_remembered_[i] = touch;
     g.force[i] = f;
     g.torque[i] = t;
   }
@@ -284,6 +289,14 @@ void Simulation::restore(double time, std::int64_t steps, const std::vector<Pair
   time_ = time;
   step_count_ = steps;
   wall_history_ = std::move(walls);
+  for (std::size_t i = 0; i < grains_.size(); ++i) {
+    wall_remembered_[i] = 0;
+    for (int w = 0; w < kWallCount; ++w) {
+      const ContactHistory& h = wall_history_[i][w];
+      const bool kept = h.slide.squaredNorm() > 0 || h.roll.squaredNorm() > 0 || h.twist != 0;
+      if (kept) wall_remembered_[i] |= std::uint8_t(1u << w);
+    }
+  }
   std::unordered_map<std::int64_t, std::uint32_t> index;
   for (std::size_t i = 0; i < grains_.size(); ++i)
     index[grains_.id[i]] = std::uint32_t(i);

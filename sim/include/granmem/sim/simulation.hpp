@@ -125,7 +125,8 @@ class Simulation {
   std::vector<PairForce> pair_force_;
   std::vector<std::array<ContactHistory, kWallCount>> wall_history_;
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
-  std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
+  std::vector<std::uint8_t> wall_touch_;       // bit w: grain touches wall w
+  std::vector<std::uint8_t> wall_remembered_;  // bit w: a committed history against wall w
   WallLoads wall_loads_;
   std::vector<std::size_t> by_id_;  // grain indices in increasing id
   static constexpr std::size_t kGrainsPerThread = 2500;

@@ -1,0 +1,292 @@
+// granmem's DEM against LAMMPS on the same packing and the same contact law: the granmem
+// half of bench/compare_lammps.sh. Lengths on the command line are in cm; data files for
+// LAMMPS are in its CGS units (atom_style sphere), everything inside granmem is SI.
+//
+//   dem_bench insert N L seed out.data        grains as granmem::deposit inserts them
+//   dem_bench settle N L seed out.h5 [threads] granmem settles that insertion, lid on top
+//   dem_bench export in.h5 out.data           a checkpoint's packing (with its lid)
+//   dem_bench time in.h5 nsteps threads       the y = 0 wall driven 0 -> A -> 0 (cosine,
+//                                              A = 1% of L) over nsteps, timed
+//   dem_bench contact-check out.data nsteps   a few grains touching each other, the walls
+//                                              and the lid: final state after nsteps
+//
+// The lid of `settle` weighs 1 kg per 15 x 15 cm (the paper's pressure; 1 kg at L = 15).
+#include <omp.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "granmem/core/error.hpp"
+#include "granmem/sim/checkpoint.hpp"
+#include "granmem/sim/deposit.hpp"
+#include "granmem/sim/simulation.hpp"
+#include "granmem/sim/wall_drive.hpp"
+
+namespace {
+
+using granmem::Container;
+using granmem::Grains;
+using granmem::Simulation;
+
+constexpr double kCm = 0.01;  // m per cm
+constexpr double kPaperBox = 0.15;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+long to_count(const std::string& text, const char* what) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (end == text.c_str() || *end != '\0' || v < 0) {
+    throw granmem::Error(std::string(what) + " '" + text + "': expected a whole number >= 0");
+  }
+  return v;
+}
+double to_number(const std::string& text, const char* what) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) {
+    throw granmem::Error(std::string(what) + " '" + text + "': expected a number");
+  }
+  return v;
+}
+
+// The deposition of N grains in an L x L box with the paper's physics and lid pressure.
+granmem::DepositOptions deposit_options(long grains, double box_cm, long seed) {
+  granmem::DepositOptions d;
+  d.grains = grains;
+  d.box_side = box_cm * kCm;
+  d.seed = std::uint64_t(seed);
+  d.lid_mass = 1.0 * (d.box_side * d.box_side) / (kPaperBox * kPaperBox);
+  return d;
+}
+
+// A LAMMPS data file (atom_style sphere, CGS): grains are type 1 with ids id + 1; the lid,
+// when present, is type 2, a point particle (diameter 0: its "density" column is its mass)
+// at the middle of the box at the height of its lower face, id N + 1. Box: x, y from 0 to
+// the box sides, z from -0.5 cm to well above the highest grain.
+void write_lammps_data(const std::filesystem::path& path, const Grains& g, const Container& c,
+                       double density, const std::string& comment) {
+  std::ofstream out(path);
+  if (!out) throw granmem::Error("cannot write " + path.string());
+  out << std::setprecision(17);
+  double top = 0;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    top = std::max(top, g.x[i].z() + g.radius[i]);
+  if (c.lid.present) top = std::max(top, c.lid.z);
+  const double lx = c.size.x() / kCm, ly = c.size.y() / kCm;
+  const double zhi = std::max(4.0 * ly, 2.0 * top / kCm + 1.0);
+  const std::size_t n = g.size(), atoms = n + (c.lid.present ? 1 : 0);
+  out << "LAMMPS data file (CGS) from granmem dem_bench: " << comment << "\n\n"
+      << atoms << " atoms\n2 atom types\n\n"
+      << std::setprecision(12) << 0.0 << " " << lx << " xlo xhi\n"
+      << 0.0 << " " << ly << " ylo yhi\n"
+      << -0.5 << " " << zhi << " zlo zhi\n\nAtoms # sphere\n\n"
+      << std::setprecision(17);
+  const double rho_cgs = density * 1e-3;  // kg/m^3 -> g/cm^3
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = g.x[i] / kCm;
+    out << g.id[i] + 1 << " 1 " << 2 * g.radius[i] / kCm << " " << rho_cgs << " " << x.x() << " "
+        << x.y() << " " << x.z() << "\n";
+  }
+  if (c.lid.present) {
+    out << n + 1 << " 2 0 " << c.lid.mass * 1e3 << " " << 0.5 * lx << " " << 0.5 * ly << " "
+        << c.lid.z / kCm << "\n";
+  }
+  out << "\nVelocities\n\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d v = g.v[i] / kCm;
+    out << g.id[i] + 1 << " " << v.x() << " " << v.y() << " " << v.z() << " " << g.w[i].x() << " "
+        << g.w[i].y() << " " << g.w[i].z() << "\n";
+  }
+  if (c.lid.present) out << n + 1 << " 0 0 " << c.lid.v / kCm << " 0 0 0\n";
+  if (!out) throw granmem::Error("error writing " + path.string());
+}
+
+int insert(const std::vector<std::string>& a) {
+  if (a.size() != 4) throw granmem::Error("usage: dem_bench insert N L_cm seed out.data");
+  const granmem::DepositOptions d =
+      deposit_options(to_count(a[0], "N"), to_number(a[1], "L"), to_count(a[2], "seed"));
+  const granmem::PhysicsOptions physics;
+  const Grains g = granmem::insert_grains(d, physics);
+  Container box;
+  box.size = {d.box_side, d.box_side};
+  write_lammps_data(a[3], g, box, physics.density,
+                    "inserted, N=" + a[0] + " L=" + a[1] + "cm seed=" + a[2]);
+  std::cout << "granmem insert: N=" << g.size() << " L_cm=" << a[1] << " seed=" << a[2]
+            << " lid_mass_g=" << d.lid_mass * 1e3 << " wrote " << a[3] << "\n";
+  return 0;
+}
+
+int settle(const std::vector<std::string>& a) {
+  if (a.size() != 4 && a.size() != 5) {
+    throw granmem::Error("usage: dem_bench settle N L_cm seed out.h5 [threads]");
+  }
+  if (a.size() == 5) omp_set_num_threads(int(to_count(a[4], "threads")));
+  const granmem::DepositOptions d =
+      deposit_options(to_count(a[0], "N"), to_number(a[1], "L"), to_count(a[2], "seed"));
+  const granmem::PhysicsOptions physics;
+  granmem::DepositSummary s;
+  double last = -1;
+  const auto start = Clock::now();
+  Simulation sim =
+      granmem::deposit(d, physics, &s, [&](const std::string& stage, double t, double e) {
+        if (t - last >= 0.1 || t < last) {
+          std::cerr << "  " << stage << ": " << std::fixed << std::setprecision(2) << t
+                    << " s simulated, kinetic energy per grain " << std::scientific
+                    << std::setprecision(2) << e << " J\n"
+                    << std::defaultfloat << std::setprecision(6);
+          last = t;
+        }
+      });
+  const double wall = seconds_since(start);
+  granmem::write_checkpoint(a[3], sim, granmem::ProtocolState{});
+  std::cout << "granmem settle: N=" << sim.grains().size() << " L_cm=" << a[1] << " seed=" << a[2]
+            << " lid_mass_g=" << d.lid_mass * 1e3 << " packing_fraction=" << s.packing_fraction
+            << " lid_height_cm=" << s.lid_height / kCm
+            << " contacts_per_grain=" << s.contacts_per_grain
+            << " settling_time_s=" << s.settling_time << " steps=" << sim.step_count()
+            << " threads=" << omp_get_max_threads() << " wall_s=" << wall << " wrote " << a[3]
+            << "\n";
+  return 0;
+}
+
+int export_data(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw granmem::Error("usage: dem_bench export in.h5 out.data");
+  const Simulation sim = granmem::read_checkpoint(a[0]);
+  write_lammps_data(a[1], sim.grains(), sim.container(), sim.physics().density,
+                    "settled packing of " + a[0]);
+  std::cout << "granmem export: N=" << sim.grains().size()
+            << " packing_fraction=" << granmem::packing_fraction(sim)
+            << " lid_height_cm=" << granmem::packing_height(sim) / kCm << " wrote " << a[1] << "\n";
+  return 0;
+}
+
+// Steps per cycle of the paper's protocol as `granmem simulate` sets it by default
+// (--period auto: a cosine drive of A = 0.15 cm at inertial number 1e-3 under half the
+// pressure of a 1 kg lid on 15 x 15 cm; the formula of app/simulate_command.cpp), with this
+// packing's grains and time step.
+double paper_steps_per_cycle(const Simulation& sim) {
+  const auto& p = sim.physics();
+  const double diameter = 2 * sim.grains().radius.at(0), amplitude = 0.01 * kPaperBox;
+  const double lid_pressure = 1.0 * p.gravity / (kPaperBox * kPaperBox);
+  const double speed =
+      granmem::quasi_static_wall_speed(1e-3, kPaperBox, diameter, 0.5 * lid_pressure, p.density);
+  const double period = granmem::WallDrive::period_for_speed(
+      amplitude, speed, granmem::DriveSymmetry::asymmetric, granmem::DriveShape::cosine);
+  return std::round(period / p.dt);
+}
+
+int time_run(const std::vector<std::string>& a) {
+  if (a.size() != 3) throw granmem::Error("usage: dem_bench time in.h5 nsteps threads");
+  const long steps = to_count(a[1], "nsteps");
+  const int threads = int(to_count(a[2], "threads"));
+  if (steps < 1 || threads < 1) throw granmem::Error("nsteps and threads must be >= 1");
+  omp_set_num_threads(threads);
+  Simulation sim = granmem::read_checkpoint(a[0]);
+  sim.set_threads(threads);  // by default a Simulation takes one thread per 2,500 grains
+  const double lid_before = granmem::packing_height(sim);
+  granmem::WallDrive drive;
+  drive.amplitude = 0.01 * sim.container().size.y();
+  drive.period = double(steps) * sim.physics().dt;
+  const double t0 = sim.time();
+  sim.set_wall_motion(
+      [drive, t0](double t) { return drive.at(std::clamp(t - t0, 0.0, drive.period)); });
+  const auto start = Clock::now();
+  sim.run(steps);
+  const double wall = seconds_since(start);
+  const double n = double(sim.grains().size());
+  double y_min = 1e300;
+  for (const auto& x : sim.grains().x)
+    y_min = std::min(y_min, x.y());
+  std::cout << "granmem time: N=" << sim.grains().size() << " threads=" << sim.threads()
+            << " steps=" << steps << " wall_s=" << wall
+            << " particle_steps_per_s=" << n * double(steps) / wall
+            << " peak_rss_mb=" << peak_rss_mb() << " A_cm=" << drive.amplitude / kCm
+            << " lid_cm_before=" << lid_before / kCm
+            << " lid_cm_after=" << granmem::packing_height(sim) / kCm
+            << " ke_per_grain_erg=" << sim.kinetic_energy() / n * 1e7
+            << " min_grain_y_cm=" << y_min / kCm
+            << " contacts_per_grain=" << 2.0 * double(sim.contact_count()) / n
+            << " steps_per_cycle_paper=" << paper_steps_per_cycle(sim) << "\n";
+  return 0;
+}
+
+// Four grains on the floor of a 3 x 3 cm box under a 2 g lid, sliding, rolling and
+// spinning against the floor, a side wall, each other and the lid: every mode of the law
+// between grains and against walls is exercised. Prints the state after nsteps (CGS).
+int contact_check(const std::vector<std::string>& a) {
+  if (a.size() != 2) throw granmem::Error("usage: dem_bench contact-check out.data nsteps");
+  const long steps = to_count(a[1], "nsteps");
+  const granmem::PhysicsOptions physics;
+  const double r = 0.0025, z = r - 1.4e-6;  // about at rest on the floor under the lid
+  Grains g;
+  g.add(0, {0.010, 0.015, z}, r, physics.density);
+  g.add(1, {r - 5e-6, 0.010, z}, r, physics.density);
+  g.add(2, {0.020, 0.020, z}, r, physics.density);
+  g.add(3, {0.020, 0.020 + 2 * r - 5e-6, z}, r, physics.density);
+  g.v[0] = {0.05, 0, 0};
+  g.w[0] = {0, 20, 10};
+  g.v[1] = {0, 0.03, 0};
+  g.w[1] = {15, -5, 8};
+  g.v[2] = {0, 0.05, 0};
+  g.w[2] = {10, 0, -30};
+  g.w[3] = {0, -10, 20};
+  Container c;
+  c.size = {0.03, 0.03};
+  c.lid.present = true;
+  c.lid.mass = 0.002;
+  c.lid.z = z + r - 1.2e-6;
+  write_lammps_data(a[0], g, c, physics.density, "contact check");
+  Simulation sim(std::move(g), c, physics);
+  sim.run(steps);
+  const Grains& s = sim.grains();
+  std::cout << std::setprecision(10);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const Eigen::Vector3d x = s.x[i] / kCm, v = s.v[i] / kCm;
+    std::cout << "grain " << s.id[i] + 1 << " " << x.x() << " " << x.y() << " " << x.z() << " "
+              << v.x() << " " << v.y() << " " << v.z() << " " << s.w[i].x() << " " << s.w[i].y()
+              << " " << s.w[i].z() << "\n";
+  }
+  std::cout << "lid " << sim.container().lid.z / kCm << " " << sim.container().lid.v / kCm << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::vector<std::string> args(argv + std::min(argc, 2), argv + argc);
+  const std::string mode = argc > 1 ? argv[1] : "";
+  try {
+    if (mode == "insert") return insert(args);
+    if (mode == "settle") return settle(args);
+    if (mode == "export") return export_data(args);
+    if (mode == "time") return time_run(args);
+    if (mode == "contact-check") return contact_check(args);
+    std::cerr << "usage: dem_bench insert|settle|export|time|contact-check ... (see the source's "
+                 "first lines)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "dem_bench " << mode << ": " << e.what() << "\n";
+    return 1;
+  }
+}

@@ -80,6 +80,9 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
                                            [&](double m) { return m == grains_.mass.front(); })) {
     uniform_sqrt_reduced_mass_ = sqrt_reduced_mass(grains_.mass.front(), grains_.mass.front());
   }
+  sqrt_mass_.resize(grains_.size());
+  for (std::size_t i = 0; i < grains_.size(); ++i)
+    sqrt_mass_[i] = std::sqrt(grains_.mass[i]);
   wall_history_.assign(grains_.size(), {});
   wall_force_on_grain_.assign(grains_.size(), {});
   wall_touch_.assign(grains_.size(), 0);
@@ -114,7 +117,7 @@ void Simulation::refresh_forces() {
 
 void Simulation::compute_forces(bool commit) {
   const std::size_t n = grains_.size();
-  const double dt = physics_.dt;
+  const double dt = physics_.dt, half_dt = 0.5 * dt;
   const auto& partner = neighbors_.partner();
   Grains& g = grains_;
 
@@ -188,7 +191,7 @@ void Simulation::compute_forces(bool commit) {
         continue;
       }
       const ContactGeometry geometry =
-          wall_contact(distance, p.normal, g.radius[i], g.v[i], g.w[i], g.mass[i], p.velocity);
+          wall_contact(distance, p.normal, g.radius[i], g.v[i], g.w[i], sqrt_mass_[i], p.velocity);
       const ContactForces c = wall_contact_.evaluate(geometry, history, dt);
       if (commit) history = c.history;
       f += c.force_on_i;
@@ -200,6 +203,10 @@ void Simulation::compute_forces(bool commit) {
     if (commit) wall_remembered_[i] = touch;
     g.force[i] = f;
     g.torque[i] = t;
+    if (commit) {  // the step's second half kick, while the grain is at hand
+      g.v[i] += half_dt * g.inv_mass[i] * f;
+      g.w[i] += half_dt * g.inv_inertia[i] * t;
+    }
   }
 
   // Loads on the walls, summed in the order of grain ids (the lid's motion depends on them).
@@ -245,13 +252,7 @@ void Simulation::step() {
   }
   if (stale) rebuild_neighbors();
 
-  compute_forces(true);
-
-#pragma omp parallel for schedule(static) num_threads(threads_)
-  for (std::size_t i = 0; i < n; ++i) {
-    g.v[i] += half * g.inv_mass[i] * g.force[i];
-    g.w[i] += half * g.inv_inertia[i] * g.torque[i];
-  }
+  compute_forces(true);  // and the grains' second half kick
   if (lid.present) lid.v += half * lid.force / lid.mass;
 }
 

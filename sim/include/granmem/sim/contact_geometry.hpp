@@ -53,10 +53,11 @@ GRANMEM_INLINE double sqrt_reduced_mass(double m_i, double m_j) {
 }
 
 // A sphere against a flat wall whose inward unit normal is `normal`, at signed distance
-// `distance` (< r_i) from the sphere's centre, moving with `wall_velocity`.
+// `distance` (< r_i) from the sphere's centre, moving with `wall_velocity`; `sqrt_m_i` is
+// the square root of the sphere's mass.
 GRANMEM_INLINE ContactGeometry wall_contact(double distance, const Eigen::Vector3d& normal,
                                             double r_i, const Eigen::Vector3d& v_i,
-                                            const Eigen::Vector3d& w_i, double m_i,
+                                            const Eigen::Vector3d& w_i, double sqrt_m_i,
                                             const Eigen::Vector3d& wall_velocity) {
   ContactGeometry g;
   g.wall = true;
@@ -64,8 +65,8 @@ GRANMEM_INLINE ContactGeometry wall_contact(double distance, const Eigen::Vector
   g.overlap = r_i - distance;
   g.l_i = distance;
   g.l_j = std::numeric_limits<double>::infinity();
-  g.l_ij = 2.0 * distance;  // the limit of 2 l_i l_j / (l_i + l_j)
-  g.sqrt_reduced_mass = std::sqrt(m_i);
+  g.l_ij = 2.0 * distance;         // the limit of 2 l_i l_j / (l_i + l_j)
+  g.sqrt_reduced_mass = sqrt_m_i;  // a wall's mass is infinite
   const Eigen::Vector3d v = v_i - wall_velocity + g.l_i * g.n.cross(w_i);
   g.v_n = v.dot(g.n);
   g.v_t = v - g.v_n * g.n;

@@ -13,13 +13,14 @@ namespace granmem {
 // moment on i is l_ij n x F_r, on j the opposite. mu_r = 0 is the do-nothing variant.
 struct RollingFriction {
   bool enabled = false;
-  double k = 0;
+  double k = 0, inv_k = 0;
   double damping_per_sqrt_mass = 0;
   double cap_per_normal_force = 0;  // mu_r beta
 
   explicit RollingFriction(const ContactParameters& p, double mu_r)
       : enabled(mu_r > 0 && p.beta > 0),
         k(p.k_n * p.beta * p.beta / 4.0),
+        inv_k(k > 0 ? 1 / k : 0),
         damping_per_sqrt_mass(dashpot_coefficient(p.k_n, p.restitution_n, 1.0) * p.beta * p.beta /
                               4.0),
         cap_per_normal_force(mu_r * p.beta) {}
@@ -31,7 +32,7 @@ struct RollingFriction {
   // The spring-slider; the moment on i is g.l_ij * n x force.
   GRANMEM_INLINE SpringSlider evaluate(const ContactGeometry& g, double normal_force,
                                        const Eigen::Vector3d& spring, double dt) const {
-    return spring_slider(spring, g.n, velocity(g), dt, k,
+    return spring_slider(spring, g.n, velocity(g), dt, k, inv_k,
                          damping_per_sqrt_mass * g.sqrt_reduced_mass,
                          cap_per_normal_force * std::abs(normal_force));
   }

@@ -106,6 +106,8 @@ class Simulation {
   void refresh_forces();
 
  private:
+  // Forces and torques at the current positions. With `commit`, a step's: contact
+  // histories are stored and the grains get the second half kick.
   void compute_forces(bool commit);
   void rebuild_neighbors();
 
@@ -129,6 +131,7 @@ class Simulation {
   std::vector<std::uint8_t> wall_remembered_;  // bit w: a committed history against wall w
   WallLoads wall_loads_;
   std::vector<std::size_t> by_id_;  // grain indices in increasing id
+  std::vector<double> sqrt_mass_;   // for the wall contacts' dashpots
   static constexpr std::size_t kGrainsPerThread = 2500;
   int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass

@@ -32,14 +32,16 @@ struct SpringSlider {
 };
 GRANMEM_INLINE SpringSlider spring_slider(const Eigen::Vector3d& spring_before,
                                           const Eigen::Vector3d& n, const Eigen::Vector3d& velocity,
-                                          double dt, double k, double c, double cap) {
+                                          double dt, double k, double inv_k, double c, double cap) {
   SpringSlider out;
   out.spring = onto_tangent_plane(spring_before, n) + velocity * dt;
   out.force = -k * out.spring - c * velocity;
   const double f_sq = out.force.squaredNorm();
   if (f_sq > cap * cap) {
     out.force *= cap / std::sqrt(f_sq);
-    out.spring = k > 0 ? Eigen::Vector3d(-(out.force + c * velocity) / k) : Eigen::Vector3d::Zero();
+    // A multiplication by 1/k: this path runs for most rolling contacts, whose slider is
+    // nearly always saturated.
+    out.spring = -inv_k * (out.force + c * velocity);
   }
   return out;
 }
@@ -48,19 +50,20 @@ GRANMEM_INLINE SpringSlider spring_slider(const Eigen::Vector3d& spring_before,
 // displacement over the life of a contact, a dashpot from the tangential restitution, and
 // Coulomb's cap mu_s |F_n|. The torque on grain i is l_i (-n x F_t).
 struct SlidingFriction {
-  double k = 0;
+  double k = 0, inv_k = 0;           // inv_k = 1/k, or 0 without a spring
   double damping_per_sqrt_mass = 0;  // C_t / sqrt(m_red)
   double mu = 0;
 
   SlidingFriction(const ContactParameters& p, double mu_s)
       : k(p.k_t()),
+        inv_k(p.k_t() > 0 ? 1 / p.k_t() : 0),
         damping_per_sqrt_mass(dashpot_coefficient(p.k_t(), p.restitution_t, 1.0)),
         mu(mu_s) {}
 
   GRANMEM_INLINE SpringSlider evaluate(const ContactGeometry& g, double normal_force,
                                        const Eigen::Vector3d& spring, double dt) const {
-    return spring_slider(spring, g.n, g.v_t, dt, k, damping_per_sqrt_mass * g.sqrt_reduced_mass,
-                         mu * std::abs(normal_force));
+    return spring_slider(spring, g.n, g.v_t, dt, k, inv_k,
+                         damping_per_sqrt_mass * g.sqrt_reduced_mass, mu * std::abs(normal_force));
   }
 };
 

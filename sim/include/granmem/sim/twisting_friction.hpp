@@ -15,13 +15,14 @@ namespace granmem {
 // mu_t = 0 is the do-nothing variant.
 struct TwistingFriction {
   bool enabled = false;
-  double k = 0;
+  double k = 0, inv_k = 0;
   double damping_per_sqrt_mass = 0;
   double cap_per_normal_force = 0;  // mu_t mu_s beta
 
   TwistingFriction(const ContactParameters& p, double mu_t, double mu_s)
       : enabled(mu_t > 0 && mu_s > 0 && p.beta > 0),
         k(p.k_t() * p.beta * p.beta / 2.0),
+        inv_k(k > 0 ? 1 / k : 0),
         damping_per_sqrt_mass(dashpot_coefficient(p.k_t(), p.restitution_t, 1.0) * p.beta * p.beta /
                               2.0),
         cap_per_normal_force(mu_t * mu_s * p.beta) {}
@@ -44,7 +45,7 @@ struct TwistingFriction {
     r.force = -k * r.spring - c * v;
     if (std::abs(r.force) > cap) {
       r.force = std::copysign(cap, r.force);
-      r.spring = k > 0 ? -(r.force + c * v) / k : 0.0;
+      r.spring = -inv_k * (r.force + c * v);
     }
     return r;
   }

@@ -73,6 +73,31 @@ const OptionSpec kOptions[] = {
     {"out", "run.h5", "end-of-cycle trajectory store"},
 };
 
+// What makes the packing and its physics: fixed for a run, and for runs started from it.
+const char* const kPackingOptions[] = {"grains",
+                                       "box",
+                                       "diameter",
+                                       "polydispersity",
+                                       "density",
+                                       "lid-mass",
+                                       "k-n",
+                                       "restitution-n",
+                                       "restitution-t",
+                                       "kt-over-kn",
+                                       "mu-s",
+                                       "mu-r",
+                                       "mu-t",
+                                       "beta",
+                                       "wall-mu-s",
+                                       "wall-mu-r",
+                                       "wall-mu-t",
+                                       "dt",
+                                       "skin",
+                                       "gravity",
+                                       "seed",
+                                       "settled-energy",
+                                       "settling-damping"};
+
 double number(const std::map<std::string, std::string>& v, const std::string& name) {
   const Quantity q = parse_quantity(v.at(name), "--" + name);
   if (!q.unit.empty()) throw Error("--" + name + " '" + v.at(name) + "': expected a plain number");
@@ -135,10 +160,17 @@ void add_simulate(CLI::App& app) {
                         ->capture_default_str();
   }
   cmd->add_option("--threads", *threads, "OpenMP threads (default: all cores)");
-  cmd->add_option("--resume", *resume, "continue the run of this checkpoint")
-      ->check(CLI::ExistingFile);
+  auto start_from = std::make_shared<std::string>();
+  CLI::Option* resume_option =
+      cmd->add_option("--resume", *resume, "continue the run of this checkpoint")
+          ->check(CLI::ExistingFile);
+  cmd->add_option("--start-from", *start_from,
+                  "start a new protocol (drive, amplitude, cycles, outputs) from the packing in "
+                  "this checkpoint, e.g. a trained state for a memory read-out")
+      ->check(CLI::ExistingFile)
+      ->excludes(resume_option);
 
-  cmd->callback([args, threads, resume, given] {
+  cmd->callback([args, threads, resume, start_from, given] {
     if (*threads > 0) omp_set_num_threads(*threads);  // deposit's and the cycles' simulations
     std::signal(SIGINT, request_stop);
     std::map<std::string, std::string> v = args->value;
@@ -156,6 +188,34 @@ void add_simulate(CLI::App& app) {
                 << (state.step_in_cycle ? " (+" + std::to_string(state.step_in_cycle) + " steps)"
                                         : std::string())
                 << "\n";
+    }
+    if (!start_from->empty()) {
+      ProtocolState trained;
+      sim.emplace(read_checkpoint(*start_from, &trained));
+      if (trained.step_in_cycle != 0) {
+        throw Error(*start_from +
+                    ": written in the middle of a cycle; a new protocol starts "
+                    "between cycles (--resume finishes that run)");
+      }
+      // The packing and its physics are the checkpoint's; the protocol is new.
+      for (const char* name : kPackingOptions) {
+        const auto it = trained.settings.find(name);
+        if (it == trained.settings.end()) {
+          throw Error(*start_from + ": has no setting '" + name +
+                      "' (was it written by granmem simulate?)");
+        }
+        const std::string& theirs = it->second;
+        if (given.at(name)->count() && args->value.at(name) != theirs) {
+          throw Error(std::string("--") + name + " " + args->value.at(name) +
+                      ": with --start-from the packing and its physics are the checkpoint's (" +
+                      theirs + ")");
+        }
+        v[name] = theirs;
+      }
+      v["start-from"] = *start_from;
+      state.settings = v;
+      std::cerr << "starting from " << *start_from << " (after cycle " << trained.cycles_done
+                << " of its run)\n";
     }
     const PhysicsOptions physics = physics_from(v);
     const double box = si(v, "box", Dimension::length);

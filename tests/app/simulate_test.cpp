@@ -67,6 +67,28 @@ TEST_F(GranmemTest, SimulateResumedGivesTheSameRun) {
   EXPECT_EQ(a.observables.at("wall_force").value, b.observables.at("wall_force").value);
 }
 
+TEST_F(GranmemTest, SimulateStartsANewProtocolFromATrainedPacking) {
+  granmem_ok(with(kTiny, {"--cycles", "1", "--out", "trained.h5"}));
+  // A read-out at another amplitude, from the trained state, into its own outputs.
+  granmem_ok({"simulate", "--start-from", "trained.checkpoint.h5", "--amplitude", "0.5%",
+              "--period", "20ms", "--cycles", "1", "--out", "readout.h5"});
+  const Trajectories trained = read_trajectories(in_work("trained.h5"));
+  const Trajectories readout = read_trajectories(in_work("readout.h5"));
+  ASSERT_EQ(readout.frames.size(), 2u);
+  // Its first frame is the trained packing exactly; then it moves on its own.
+  EXPECT_EQ(readout.frames[0].position, trained.frames.back().position);
+  EXPECT_EQ(readout.frames[0].orientation, trained.frames.back().orientation);
+  EXPECT_NE(readout.frames[1].position, readout.frames[0].position);
+  EXPECT_EQ(readout.header.parameters.at("simulate/amplitude"), "0.5%");
+  EXPECT_EQ(readout.header.parameters.at("simulate/start-from"), "trained.checkpoint.h5");
+  // The packing's physics are the checkpoint's: another friction is refused.
+  const RunResult r = granmem({"simulate", "--start-from", "trained.checkpoint.h5", "--mu-s", "0.5",
+                               "--cycles", "1", "--out", "other.h5"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--mu-s"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(in_work("other.h5")));
+}
+
 TEST_F(GranmemTest, SimulateRefusesBadConfigurationsBeforeWriting) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--k-n", "-4e6g/s^2"}, "k_n"},

@@ -285,16 +285,7 @@ void add_simulate(CLI::App& app) {
     if (!sim) {
       std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
       DepositSummary s;
-      double last = -1;
-      sim.emplace(deposit(d, physics, &s, [&](const std::string& stage, double t, double e) {
-        if (t - last >= 0.1 || t < last) {
-          std::cerr << "  " << stage << ": " << std::fixed << std::setprecision(2) << t
-                    << " s simulated, kinetic energy per grain " << std::scientific
-                    << std::setprecision(2) << e << " J\n"
-                    << std::defaultfloat << std::setprecision(6);
-          last = t;
-        }
-      }));
+      sim.emplace(deposit(d, physics, &s, print_deposit_progress(std::cerr)));
       std::cerr << "settled: packing fraction " << s.packing_fraction << ", lid at "
                 << s.lid_height * 100 << " cm, " << s.contacts_per_grain << " contacts per grain\n";
       state.settings = v;

@@ -146,18 +146,8 @@ int settle(const std::vector<std::string>& a) {
       deposit_options(to_count(a[0], "N"), to_number(a[1], "L"), to_count(a[2], "seed"));
   const granmem::PhysicsOptions physics;
   granmem::DepositSummary s;
-  double last = -1;
   const auto start = Clock::now();
-  Simulation sim =
-      granmem::deposit(d, physics, &s, [&](const std::string& stage, double t, double e) {
-        if (t - last >= 0.1 || t < last) {
-          std::cerr << "  " << stage << ": " << std::fixed << std::setprecision(2) << t
-                    << " s simulated, kinetic energy per grain " << std::scientific
-                    << std::setprecision(2) << e << " J\n"
-                    << std::defaultfloat << std::setprecision(6);
-          last = t;
-        }
-      });
+  Simulation sim = granmem::deposit(d, physics, &s, granmem::print_deposit_progress(std::cerr));
   const double wall = seconds_since(start);
   granmem::write_checkpoint(a[3], sim, granmem::ProtocolState{});
   std::cout << "granmem settle: N=" << sim.grains().size() << " L_cm=" << a[1] << " seed=" << a[2]

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <memory>
 
 #include "granmem/core/error.hpp"
 
@@ -11,6 +13,20 @@ double Random::normal() {
   // Box-Muller; 1 - u keeps the logarithm finite.
   const double u = 1.0 - uniform(), v = uniform();
   return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * M_PI * v);
+}
+
+DepositProgress print_deposit_progress(std::ostream& out) {
+  auto last = std::make_shared<double>(-1);
+  return [&out, last](const std::string& stage, double t, double energy) {
+    if (t - *last < 0.1 && t >= *last) return;  // a new stage starts again at 0
+    *last = t;
+    const auto flags = out.flags();
+    const auto precision = out.precision();
+    out << "  " << stage << ": " << std::fixed << std::setprecision(2) << t
+        << " s simulated, kinetic energy per grain " << std::scientific << energy << " J\n";
+    out.flags(flags);
+    out.precision(precision);
+  };
 }
 
 double packing_height(const Simulation& sim) {

@@ -2,6 +2,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <ostream>
 #include <random>
 #include <string>
 
@@ -35,6 +36,10 @@ struct DepositSummary {
 
 // Progress of a long stage: simulated time, kinetic energy per grain.
 using DepositProgress = std::function<void(const std::string& stage, double time, double energy)>;
+
+// A progress callback that prints each stage's simulated time and kinetic energy per grain
+// to `out`, every 0.1 s of simulated time.
+DepositProgress print_deposit_progress(std::ostream& out);
 
 Simulation deposit(const DepositOptions& options, const PhysicsOptions& physics,
                    DepositSummary* summary = nullptr, const DepositProgress& progress = {});

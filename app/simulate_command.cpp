@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <iostream>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "commands.hpp"
@@ -109,8 +110,39 @@ double si(const std::map<std::string, std::string>& v, const std::string& name, 
 }
 std::int64_t whole(const std::map<std::string, std::string>& v, const std::string& name) {
   const double x = number(v, name);
-  if (x != std::floor(x) || x < 0) throw Error("--" + name + ": expected a whole number >= 0");
+  if (x != std::floor(x) || x < 0 || x > 9e15) {
+    throw Error("--" + name + " '" + v.at(name) + "': expected a whole number >= 0");
+  }
   return std::int64_t(x);
+}
+bool yes_no(const std::map<std::string, std::string>& v, const std::string& name) {
+  const std::string& x = v.at(name);
+  if (x == "true" || x == "yes" || x == "on" || x == "1") return true;
+  if (x == "false" || x == "no" || x == "off" || x == "0") return false;
+  throw Error("--" + name + " '" + x + "': expected true or false");
+}
+
+// The files a run writes must be distinct, must not be the checkpoint it starts from, and
+// must go to folders that exist: checked before anything is computed.
+void check_outputs(const std::vector<std::filesystem::path>& outputs,
+                   const std::filesystem::path& source) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> seen;
+  for (const fs::path& p : outputs) {
+    const fs::path folder = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+    if (!fs::is_directory(folder)) {
+      throw Error(p.string() + ": folder '" + folder.string() + "' does not exist");
+    }
+    const fs::path full = fs::weakly_canonical(p);
+    if (!source.empty() && full == fs::weakly_canonical(source)) {
+      throw Error(p.string() + ": is the checkpoint this run starts from; choose another --out");
+    }
+    for (const fs::path& other : seen) {
+      if (full == other)
+        throw Error(p.string() + ": written twice by this run (--out, --checkpoint)");
+    }
+    seen.push_back(full);
+  }
 }
 
 PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
@@ -159,7 +191,8 @@ void add_simulate(CLI::App& app) {
     given[o.name] = cmd->add_option(std::string("--") + o.name, args->value[o.name], o.help)
                         ->capture_default_str();
   }
-  cmd->add_option("--threads", *threads, "OpenMP threads (default: all cores)");
+  cmd->add_option("--threads", *threads,
+                  "OpenMP threads (default: one per 2,500 grains, up to all cores)");
   auto start_from = std::make_shared<std::string>();
   CLI::Option* resume_option =
       cmd->add_option("--resume", *resume, "continue the run of this checkpoint")
@@ -172,17 +205,25 @@ void add_simulate(CLI::App& app) {
 
   cmd->callback([args, threads, resume, start_from, given] {
     if (*threads > 0) omp_set_num_threads(*threads);  // deposit's and the cycles' simulations
-    std::signal(SIGINT, request_stop);
     std::map<std::string, std::string> v = args->value;
     ProtocolState state;
     std::optional<Simulation> sim;
     if (!resume->empty()) {
       sim.emplace(read_checkpoint(*resume, &state));
       // The run goes on with the settings it started with; more cycles may be asked for.
-      for (const auto& [key, value] : state.settings)
-        v[key] = value;
-      for (const char* may_change : {"cycles", "checkpoint-every"}) {
-        if (given.at(may_change)->count()) v[may_change] = args->value.at(may_change);
+      for (const auto& [key, value] : state.settings) {
+        const bool may_change = key == "cycles" || key == "checkpoint-every";
+        const auto option = given.find(key);
+        if (option != given.end() && option->second->count() && args->value.at(key) != value) {
+          if (!may_change) {
+            throw Error("--" + key + " " + args->value.at(key) + ": a resumed run keeps its " +
+                        "settings (" + value + "); only --cycles and --checkpoint-every change");
+          }
+          v[key] = args->value.at(key);
+          state.settings[key] = v[key];
+        } else {
+          v[key] = value;
+        }
       }
       std::cerr << "resuming " << *resume << " after cycle " << state.cycles_done
                 << (state.step_in_cycle ? " (+" + std::to_string(state.step_in_cycle) + " steps)"
@@ -220,6 +261,12 @@ void add_simulate(CLI::App& app) {
     const PhysicsOptions physics = physics_from(v);
     const double box = si(v, "box", Dimension::length);
     const double radius = 0.5 * si(v, "diameter", Dimension::length);
+    if (!(box > 0)) throw Error("--box '" + v.at("box") + "': must be positive");
+    if (!(radius > 0)) throw Error("--diameter '" + v.at("diameter") + "': must be positive");
+    const double polydispersity = number(v, "polydispersity");
+    if (!(polydispersity >= 0 && polydispersity < 1)) {
+      throw Error("--polydispersity " + v.at("polydispersity") + ": must be in [0, 1)");
+    }
     const std::string out = v.at("out");
     std::string checkpoint = v.at("checkpoint");
     if (checkpoint.empty()) {
@@ -231,7 +278,7 @@ void add_simulate(CLI::App& app) {
     DepositOptions d;
     d.grains = whole(v, "grains");
     d.radius = radius;
-    d.polydispersity = number(v, "polydispersity");
+    d.polydispersity = polydispersity;
     d.box_side = box;
     d.lid_mass = si(v, "lid-mass", Dimension::mass);
     d.seed = std::uint64_t(whole(v, "seed"));
@@ -254,6 +301,9 @@ void add_simulate(CLI::App& app) {
     c.drive.symmetry = parse_drive_symmetry(v.at("drive"));
     c.drive.shape = parse_drive_shape(v.at("wall-motion"));
     if (v.at("period") == "auto") {
+      if (!(number(v, "inertial-number") > 0)) {
+        throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
+      }
       // Under the lid the confining pressure is its weight over the box; the lateral stress
       // just beneath it, about half that, is the smallest in the packing. Without a lid, the
       // weight of one layer of grains.
@@ -267,7 +317,7 @@ void add_simulate(CLI::App& app) {
       c.drive.period = si(v, "period", Dimension::time);
     }
     c.out = out;
-    c.full_compression_frames = v.at("full-compression") == "true";
+    c.full_compression_frames = yes_no(v, "full-compression");
     std::stringstream track(v.at("track"));
     for (std::string id; std::getline(track, id, ',');) {
       if (id.empty()) continue;
@@ -278,9 +328,29 @@ void add_simulate(CLI::App& app) {
       c.tracked_grains.push_back(std::int64_t(q.value));
     }
     c.samples_per_cycle = whole(v, "samples-per-cycle");
+    if (c.tracked_grains.empty() != (c.samples_per_cycle == 0)) {
+      throw Error("--track and --samples-per-cycle go together: which grains, and how often");
+    }
+    {
+      // Tracked grains must exist: a new packing's ids are 0 .. grains - 1.
+      std::set<std::int64_t> ids;
+      if (sim) ids.insert(sim->grains().id.begin(), sim->grains().id.end());
+      for (std::int64_t id : c.tracked_grains) {
+        const bool exists = sim ? ids.count(id) > 0 : id >= 0 && id < d.grains;
+        if (!exists) throw Error("--track: there is no grain " + std::to_string(id));
+      }
+      std::set<std::int64_t> once(c.tracked_grains.begin(), c.tracked_grains.end());
+      if (once.size() != c.tracked_grains.size()) throw Error("--track: a grain is listed twice");
+    }
     c.checkpoint = checkpoint;
     c.checkpoint_every = whole(v, "checkpoint-every");
     c.validate(box_y, physics.dt);
+    {
+      std::vector<std::filesystem::path> outputs{c.out, c.checkpoint};
+      if (c.full_compression_frames) outputs.push_back(full_compression_path(c.out));
+      if (c.samples_per_cycle > 0) outputs.push_back(in_cycle_path(c.out));
+      check_outputs(outputs, *start_from);
+    }
 
     if (!sim) {
       std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
@@ -298,6 +368,7 @@ void add_simulate(CLI::App& app) {
               << " s (" << std::int64_t(steps_per_cycle) << " steps, peak wall speed "
               << c.drive.peak_speed() * 100 << " cm/s), " << c.cycles << " cycles\n";
 
+    std::signal(SIGINT, request_stop);  // from here on, Ctrl-C writes a checkpoint
     const CyclicSummary summary = run_cycles(
         *sim, c, state,
         [](const CyclicProgress& p) {

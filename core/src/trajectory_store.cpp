@@ -63,6 +63,15 @@ void write_parameters(hid_t file, const std::map<std::string, std::string>& para
   }
 }
 
+// /parameters: what produced the file, and the voxel size of image data.
+void write_run_parameters(hid_t file, const RunHeader& h) {
+  write_parameters(file, h.parameters);
+  if (h.voxel_size) {
+    h5::Handle params = h5::create_group(file, "/parameters");
+    h5::write(params.get(), "voxel_size", h.voxel_size->data(), {3}, h.length_unit);
+  }
+}
+
 void read_parameters(const h5::File& file, const std::string& path, const std::string& prefix,
                      std::map<std::string, std::string>& out) {
   h5::Handle g = h5::open_group(file, path);
@@ -101,8 +110,16 @@ struct TrajectoryWriter::Impl {
   void check_open(const std::string& what) const {
     if (file.id() < 0) throw Error(out.target().string() + ": cannot " + what + " after commit()");
   }
-  // Observables are written whole, replacing what an earlier publish() wrote.
+  bool parameters_changed = false;
+
+  // Observables are written whole, replacing what an earlier publish() wrote; so are the
+  // parameters when they changed.
   void write_observables() {
+    if (parameters_changed) {
+      h5::remove(file.id(), "/parameters");
+      write_run_parameters(file.id(), header);
+      parameters_changed = false;
+    }
     h5::remove(file.id(), "/observables");
     for (const auto& [name, obs] : observables) {
       h5::Handle g = h5::create_group(file.id(), "/observables/" + name);
@@ -157,11 +174,13 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader 
         f, std::string(kGrains) + "/hole_contact", {n}, "1", h.time_unit);
   }
 
-  write_parameters(f, h.parameters);
-  if (h.voxel_size) {
-    h5::Handle params = h5::create_group(f, "/parameters");
-    h5::write(params.get(), "voxel_size", h.voxel_size->data(), {3}, h.length_unit);
-  }
+  write_run_parameters(f, h);
+}
+
+void TrajectoryWriter::set_parameters(std::map<std::string, std::string> parameters) {
+  impl_->check_open("set parameters");
+  impl_->header.parameters = std::move(parameters);
+  impl_->parameters_changed = true;
 }
 
 TrajectoryWriter::~TrajectoryWriter() = default;

@@ -175,8 +175,7 @@ void write_checkpoint(const std::filesystem::path& path, const Simulation& sim,
     h5::write(wall_contacts.get(), "twist", w_twist.data(), {n, wc}, "m");
 
     std::map<std::string, double> progress{{"cycles_done", double(protocol.cycles_done)},
-                                           {"step_in_cycle", double(protocol.step_in_cycle)},
-                                           {"cycle_start", protocol.cycle_start}};
+                                           {"step_in_cycle", double(protocol.step_in_cycle)}};
     for (const auto& [name, frames] : protocol.frames_written) {
       progress["frames_" + name] = double(frames);
     }
@@ -215,11 +214,15 @@ Simulation read_checkpoint(const std::filesystem::path& path, ProtocolState* pro
   grains.x = vectors(h5::read<double>(f, g + "position"), n, where + " position");
   grains.v = vectors(h5::read<double>(f, g + "velocity"), n, where + " velocity");
   grains.w = vectors(h5::read<double>(f, g + "angular_velocity"), n, where + " angular velocity");
-  const std::vector<Eigen::Vector3d> force = vectors(h5::read<double>(f, g + "force"), n, where);
-  const std::vector<Eigen::Vector3d> torque = vectors(h5::read<double>(f, g + "torque"), n, where);
+  const std::vector<Eigen::Vector3d> force =
+      vectors(h5::read<double>(f, g + "force"), n, where + " " + g + "force");
+  const std::vector<Eigen::Vector3d> torque =
+      vectors(h5::read<double>(f, g + "torque"), n, where + " " + g + "torque");
   const std::vector<double> q = h5::read<double>(f, g + "orientation");
-  if (q.size() != 4 * n || grains.radius.size() != n || grains.mass.size() != n) {
-    throw Error(where + ": grain datasets of unequal lengths");
+  if (q.size() != 4 * n || grains.radius.size() != n || grains.mass.size() != n ||
+      grains.inv_mass.size() != n || grains.inv_inertia.size() != n) {
+    throw Error(where + ": grain datasets of unequal lengths (expected " + std::to_string(n) +
+                " grains)");
   }
   for (std::size_t i = 0; i < n; ++i) {
     grains.q.emplace_back(q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]);
@@ -296,13 +299,13 @@ Simulation read_checkpoint(const std::filesystem::path& path, ProtocolState* pro
     const Table t = h5::read_table(f, "/checkpoint/protocol");
     *protocol = ProtocolState{};
     for (const Column& col : t.columns()) {
-      const double v = col.values.at(0);
+      if (col.values.size() != 1)
+        throw Error(where + ": protocol value '" + col.name + "' damaged");
+      const double v = col.values[0];
       if (col.name == "cycles_done")
         protocol->cycles_done = std::int64_t(v);
       else if (col.name == "step_in_cycle")
         protocol->step_in_cycle = std::int64_t(v);
-      else if (col.name == "cycle_start")
-        protocol->cycle_start = v;
       else if (col.name.rfind("frames_", 0) == 0)
         protocol->frames_written[col.name.substr(7)] = std::int64_t(v);
       else if (col.name.rfind("pending_", 0) == 0)

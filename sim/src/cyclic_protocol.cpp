@@ -65,6 +65,22 @@ double driven_wall_force(const Simulation& sim) {
   return -sim.wall_loads().force[int(Wall::y_low)].y();
 }
 
+// A run whose state became non-finite (a time step too large for the forces at hand) must
+// stop before NaN positions are written, where they would read as "grain not seen".
+void check_finite(const Simulation& sim, std::int64_t cycle) {
+  const Grains& g = sim.grains();
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!g.x[i].allFinite() || !g.v[i].allFinite() || !g.w[i].allFinite()) {
+      throw Error("cycle " + std::to_string(cycle) + ": grain " + std::to_string(g.id[i]) +
+                  " has a non-finite position or velocity; the run is unstable (try a smaller "
+                  "time step)");
+    }
+  }
+  if (!std::isfinite(sim.container().lid.z)) {
+    throw Error("cycle " + std::to_string(cycle) + ": the lid's height is not finite");
+  }
+}
+
 struct Output {
   std::unique_ptr<TrajectoryWriter> writer;
   RunHeader header;
@@ -95,11 +111,8 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
   const WallDrive& drive = o.drive;
   o.validate(sim.container().size.y(), dt);
   const auto steps_per_cycle = std::llround(drive.period / dt);
-  const auto full_step = std::llround(drive.full_compression_time() / dt);
-  const std::int64_t sample_every =
-      o.samples_per_cycle > 0 ? std::max<std::int64_t>(1, steps_per_cycle / o.samples_per_cycle)
-                              : 0;
-
+  const auto full_step =
+      std::llround(drive.full_compression_time() / drive.period * double(steps_per_cycle));
   const Grains& g = sim.grains();
   std::vector<std::size_t> all(g.size()), tracked;
   for (std::size_t i = 0; i < g.size(); ++i)
@@ -114,6 +127,14 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
       tracked.push_back(it->second);
     }
   }
+
+  // In-cycle samples at the steps where step * samples / steps_per_cycle moves on: exactly
+  // samples_per_cycle of them, evenly spread, the last at the end of the cycle.
+  const std::int64_t samples = tracked.empty() ? 0 : o.samples_per_cycle;
+  auto sample_due = [&](std::int64_t step) {
+    return samples > 0 &&
+           (step * samples) / steps_per_cycle != ((step - 1) * samples) / steps_per_cycle;
+  };
 
   // Outputs: new, or continued after the frames a checkpoint counted.
   const bool fresh = state.frames_written.empty();
@@ -133,12 +154,13 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
       }
       out.writer = std::make_unique<TrajectoryWriter>(
           TrajectoryWriter::resume(path, std::size_t(it->second)));
+      out.writer->set_parameters(o.parameters);  // a resumed run may have more cycles
       out.header = out.writer->header();
     }
   };
   open(kEnd, o.out, all);
   if (o.full_compression_frames) open(kFull, full_compression_path(o.out), all);
-  if (sample_every > 0 && !tracked.empty()) open(kInCycle, in_cycle_path(o.out), tracked);
+  if (samples > 0) open(kInCycle, in_cycle_path(o.out), tracked);
   std::map<std::string, Observable> observables = outputs[kEnd].writer->observables();
 
   auto record = [&](const char* name, const char* unit, double value) {
@@ -202,19 +224,24 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
     progress(p);
   };
 
-  // The wall follows the drive by step count, so that a resumed run moves it identically.
-  sim.set_wall_motion([&](double) { return drive.at(double(state.step_in_cycle + 1) * dt); });
+  // The wall follows the drive by step count, so that a resumed run moves it identically;
+  // step k of n is at k/n of the period, so that a cycle ends exactly where it began. The
+  // motion refers to this function's locals: it is removed however the function ends.
+  sim.set_wall_motion([&](double) {
+    return drive.at(drive.period * double(state.step_in_cycle + 1) / double(steps_per_cycle));
+  });
+  struct ClearWallMotion {
+    Simulation& sim;
+    ~ClearWallMotion() { sim.set_wall_motion({}); }
+  } clear_wall_motion{sim};
+
   while (state.cycles_done < o.cycles) {
-    if (state.step_in_cycle == 0) {
-      state.cycle_start = sim.time();
-      state.pending.clear();
-    }
+    if (state.step_in_cycle == 0) state.pending.clear();
     while (state.step_in_cycle < steps_per_cycle) {
       if (stop && stop->load(std::memory_order_relaxed)) {
         save(false);
         summary.interrupted = true;
         summary.cycles_done = state.cycles_done;
-        sim.set_wall_motion({});
         return summary;
       }
       sim.step();
@@ -224,15 +251,12 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
         state.pending["wall_force_full_compression"] = driven_wall_force(sim);
         if (o.full_compression_frames) append(kFull, state.cycles_done + 1);
       }
-      if (sample_every > 0 && !tracked.empty() && state.step_in_cycle % sample_every == 0) {
-        append(kInCycle, sim.step_count());
-      }
+      if (sample_due(state.step_in_cycle)) append(kInCycle, sim.step_count());
       if ((steps_run & 255) == 0) report(false);
     }
     ++state.cycles_done;
     state.step_in_cycle = 0;
-    // The drive ends where it began; set it exactly, not by the cosine's rounding.
-    sim.container().y_wall = 0;
+    check_finite(sim, state.cycles_done);
     append(kEnd, state.cycles_done);
     const auto pending = state.pending.find("wall_force_full_compression");
     end_of_cycle_observables(pending != state.pending.end() ? pending->second : std::nan(""));
@@ -242,7 +266,6 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
       save(false);
     }
   }
-  sim.set_wall_motion({});
   save(true);
   summary.cycles_done = state.cycles_done;
   summary.wall_seconds =

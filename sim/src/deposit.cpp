@@ -82,20 +82,24 @@ Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
     throw Error("deposit: polydispersity must be in [0, 1)");
   }
   const double r_max = o.radius * (1 + o.polydispersity);
-  if (!(o.box_side > 4 * r_max)) throw Error("deposit: the box must be wider than two grains");
+  if (!(o.box_side > 6 * r_max)) {
+    throw Error("deposit: the box must be wider than three grains");
+  }
   if (!(o.lid_mass >= 0)) throw Error("deposit: lid mass must be zero or positive");
   physics.validate("deposit", o.radius * (1 - o.polydispersity));
 
-  // A loose lattice with gaps, so that random shifts never make grains overlap.
+  // A loose lattice with gaps, so that random shifts never make grains overlap each other
+  // or the walls: every site is at least r_max + jitter from the floor and the side walls.
   Random random(o.seed);
   const double spacing = 2.4 * r_max, jitter = 0.45 * (spacing - 2 * r_max);
+  const double margin = r_max + jitter;
   const auto per_row =
-      static_cast<std::int64_t>(std::floor((o.box_side - 2 * r_max) / spacing)) + 1;
+      static_cast<std::int64_t>(std::floor((o.box_side - 2 * margin) / spacing)) + 1;
   Grains grains;
   for (std::int64_t k = 0; k < o.grains; ++k) {
     const std::int64_t layer = k / (per_row * per_row), in_layer = k % (per_row * per_row);
-    const Eigen::Vector3d site(r_max + spacing * double(in_layer % per_row),
-                               r_max + spacing * double(in_layer / per_row),
+    const Eigen::Vector3d site(margin + spacing * double(in_layer % per_row),
+                               margin + spacing * double(in_layer / per_row),
                                r_max + spacing * double(layer));
     const Eigen::Vector3d shift(jitter * (2 * random.uniform() - 1),
                                 jitter * (2 * random.uniform() - 1), jitter * random.uniform());

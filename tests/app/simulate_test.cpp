@@ -89,6 +89,42 @@ TEST_F(GranmemTest, SimulateStartsANewProtocolFromATrainedPacking) {
   EXPECT_FALSE(fs::exists(in_work("other.h5")));
 }
 
+TEST_F(GranmemTest, SimulateNeverOverwritesWhatItStartsFrom) {
+  granmem_ok(with(kTiny, {"--cycles", "1", "--out", "run.h5"}));
+  const auto before = snapshot(work());
+  // The default --out (run.h5) would overwrite the trained run and its checkpoint.
+  RunResult r = granmem(
+      {"simulate", "--start-from", "run.checkpoint.h5", "--cycles", "1", "--period", "20ms"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("starts from"), std::string::npos) << r.err;
+  // One file for two outputs.
+  r = granmem(with(kTiny, {"--cycles", "1", "--out", "same.h5", "--checkpoint", "same.h5"}));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("written twice"), std::string::npos) << r.err;
+  // A folder that is not there, a grain that is not there: refused before any work.
+  r = granmem(with(kTiny, {"--cycles", "1", "--out", "nowhere/run2.h5"}));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+  r = granmem(with(
+      kTiny, {"--cycles", "1", "--out", "run3.h5", "--track", "60", "--samples-per-cycle", "5"}));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_EQ(snapshot(work()), before);
+}
+
+TEST_F(GranmemTest, SimulateResumedKeepsItsSettings) {
+  granmem_ok(with(kTiny, {"--cycles", "1", "--out", "run.h5"}));
+  const RunResult r =
+      granmem({"simulate", "--resume", "run.checkpoint.h5", "--cycles", "2", "--amplitude", "5%"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--amplitude"), std::string::npos) << r.err;
+  granmem_ok({"simulate", "--resume", "run.checkpoint.h5", "--cycles", "2"});
+  const TrajectoryReader run(in_work("run.h5"));
+  EXPECT_EQ(run.frame_count(), 3u);
+  // The parameters say what was run: two cycles now.
+  EXPECT_EQ(run.header().parameters.at("simulate/cycles"), "2");
+}
+
 TEST_F(GranmemTest, SimulateRefusesBadConfigurationsBeforeWriting) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--k-n", "-4e6g/s^2"}, "k_n"},
@@ -97,6 +133,10 @@ TEST_F(GranmemTest, SimulateRefusesBadConfigurationsBeforeWriting) {
       {{"--mu-s", "-0.1"}, "mu_s"},
       {{"--restitution-n", "1.5"}, "restitution_n"},
       {{"--dt", "25 furlongs"}, "--dt"},
+      {{"--full-compression", "maybe"}, "--full-compression"},
+      {{"--polydispersity", "1"}, "--polydispersity"},
+      {{"--grains", "1e30"}, "--grains"},
+      {{"--track", "3"}, "--samples-per-cycle"},
   };
   for (const auto& [bad, named] : cases) {
     const RunResult r = granmem(with(with(kTiny, {"--cycles", "1", "--out", "bad.h5"}), bad));
@@ -108,6 +148,12 @@ TEST_F(GranmemTest, SimulateRefusesBadConfigurationsBeforeWriting) {
     EXPECT_NE(last.find(named), std::string::npos) << last;
     EXPECT_FALSE(fs::exists(in_work("bad.h5"))) << bad[0];
   }
+  // The automatic period needs a positive inertial number.
+  const RunResult r = granmem({"simulate", "--grains", "60", "--box", "2cm", "--cycles", "1",
+                               "--inertial-number", "0", "--out", "bad.h5"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.err_lines().size(), 1u) << r.err;
+  EXPECT_NE(r.err.find("--inertial-number"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -41,6 +41,8 @@ class TrajectoryWriter {
 
   void append(const Frame& frame);
   void set_observable(const std::string& name, Observable observable);
+  // Replaces what the file says produced it (a resumed run asked for more cycles).
+  void set_parameters(std::map<std::string, std::string> parameters);
   const std::map<std::string, Observable>& observables() const;
   const RunHeader& header() const;
   std::size_t frame_count() const;

@@ -14,7 +14,6 @@ namespace granmem {
 struct ProtocolState {
   std::int64_t cycles_done = 0;    // completed cycles
   std::int64_t step_in_cycle = 0;  // steps taken in the cycle under way
-  double cycle_start = 0;          // simulated time at which the cycle under way began
   // Frames already in each output (end_of_cycle, full_compression, in_cycle), and values
   // measured earlier in the cycle under way.
   std::map<std::string, std::int64_t> frames_written;

@@ -116,15 +116,4 @@ void NeighborList::build(const Grains& g) {
   }
 }
 
-bool NeighborList::stale(const Grains& g) const {
-  if (built_at_.size() != g.size()) return true;
-  const double limit_sq = 0.25 * skin_ * skin_;
-  bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved) num_threads(threads_)
-  for (std::size_t i = 0; i < g.size(); ++i) {
-    moved = moved || (g.x[i] - built_at_[i]).squaredNorm() > limit_sq;
-  }
-  return moved;
-}
-
 }  // namespace granmem

@@ -1,7 +1,7 @@
 // The Verlet list against brute force: every pair closer than r_i + r_j + skin listed exactly
 // once, under the grain of smaller id, each grain's pairs sorted by the partner's id, the
 // incoming lists their exact transpose sorted by the owner's id; carry() keeps the values of
-// pairs present before and after; stale() trips at half the skin.
+// pairs present before and after; moved_too_far() trips at half the skin.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -184,15 +184,15 @@ TEST(NeighborList, IsStaleOnceAGrainHasMovedMoreThanHalfTheSkin) {
   const double skin = 4e-4;
   Grains g = random_grains(50, 0.03, 8);
   NeighborList list(skin);
-  EXPECT_TRUE(list.stale(g)) << "never built";
+  EXPECT_TRUE(list.moved_too_far(g.x[0], 0)) << "never built";
   list.build(g);
-  EXPECT_FALSE(list.stale(g));
+  EXPECT_FALSE(list.moved_too_far(g.x[17], 17));
   g.x[17] += Eigen::Vector3d(0, 0.49 * skin, 0);
-  EXPECT_FALSE(list.stale(g));
+  EXPECT_FALSE(list.moved_too_far(g.x[17], 17));
   g.x[17] += Eigen::Vector3d(0, 0.02 * skin, 0);
-  EXPECT_TRUE(list.stale(g));
+  EXPECT_TRUE(list.moved_too_far(g.x[17], 17));
   list.build(g);
-  EXPECT_FALSE(list.stale(g));
+  EXPECT_FALSE(list.moved_too_far(g.x[17], 17));
 }
 
 }  // namespace

@@ -19,9 +19,8 @@ class NeighborList {
 
   // Rebuilds from the grains' current positions.
   void build(const Grains& grains);
-  // True once some grain has moved more than half the skin since the last build.
-  bool stale(const Grains& grains) const;
-  // The same test for grain i at position x.
+  // True once grain i, now at x, has moved more than half the skin since the last build:
+  // the list must then be rebuilt.
   bool moved_too_far(const Eigen::Vector3d& x, std::size_t i) const {
     return i >= built_at_.size() || (x - built_at_[i]).squaredNorm() > 0.25 * skin_ * skin_;
   }

@@ -13,6 +13,8 @@ void add_info(CLI::App& app);
 void add_analyze(CLI::App& app);
 void add_export(CLI::App& app);
 void add_simulate(CLI::App& app);
+void add_render(CLI::App& app);
+void add_link(CLI::App& app);
 
 // The options of a subcommand as actually used (given or default), "<command>/<option>"
 // -> value, for the output's /parameters.

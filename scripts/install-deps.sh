@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libeigen3-dev libhdf5-dev hdf5-tools libcli11-dev libopencv-dev libceres-dev
+  libeigen3-dev libhdf5-dev hdf5-tools libcli11-dev libopencv-dev libceres-dev libtiff-dev
   libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libnanoflann-dev
   gnuplot-nox
 )

@@ -1,0 +1,47 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "granmem/core/table.hpp"
+#include "granmem/core/trajectories.hpp"
+
+namespace granmem {
+
+// The grains found in one scan, a table with stable columns: frame, particle (the
+// detection's index), x, y, z, radius, quality, edge (1: cut by the stack's border), and,
+// where the cavity axis was looked for, ax, ay, az (unit, unsigned; NaN when not seen),
+// axis_quality, hole_contact (1: touches a neighbour through its hole). Lengths in
+// `length_unit` (voxel, or the unit of the voxel size).
+struct Detections {
+  std::int64_t frame = 0;  // scan index
+  std::string length_unit = "voxel";
+  std::optional<Eigen::Vector3d> voxel_size;  // in length_unit, when known
+  std::string source;                         // the stack
+
+  Vectors3 position;  // N x 3
+  std::vector<double> radius, quality;
+  std::vector<std::uint8_t> edge;
+  bool has_axis = false;
+  Vectors3 axis;  // N x 3 when has_axis
+  std::vector<double> axis_quality;
+  std::vector<std::uint8_t> hole_contact;
+
+  std::size_t size() const { return static_cast<std::size_t>(position.rows()); }
+  // Appends one detection (axis fields NaN/0 until set).
+  void add(const Eigen::Vector3d& x, double r, double q, bool on_edge);
+};
+
+Table to_table(const Detections& d);
+Detections from_table(const Table& t, const std::string& where);
+
+// Detections file: HDF5 (the table under /detections, with attributes length_unit,
+// voxel_size, source, frame) or, for a .csv name, the CSV table. Written atomically.
+void write_detections(const Detections& d, const std::filesystem::path& path);
+Detections read_detections(const std::filesystem::path& path);
+
+}  // namespace granmem

@@ -1,0 +1,41 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "granmem/tracking/holed_sphere.hpp"
+
+namespace granmem {
+
+// The voxels around one grain: physical positions, normalised intensities (fluid 1,
+// grain 0) and, optionally, how much of each the neighbouring grains leave clear
+// (prod (1 - M_neighbour), 1 where no neighbour reaches).
+struct GrainWindow {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> intensity;
+  std::vector<double> clear;  // empty: neighbours not modelled
+};
+
+// A blurred holed sphere fitted to a window by least squares (Ceres' TinySolver,
+// Levenberg-Marquardt, analytic Jacobian): centre, radius, blur, fluid and grain levels,
+// and the hole's axis when the grain has a hole. The scan is modelled as
+//   b - (b - g) (1 - (1 - M) clear)
+// so that neighbours seen in the window are part of the model instead of pulling the fit.
+struct GrainFit {
+  HoledSphere sphere;
+  double fluid = 1, grain = 0;  // b, g
+  double rms = 0;               // residual root mean square
+  int iterations = 0;
+  bool converged = false;
+};
+
+struct GrainFitOptions {
+  bool fit_axis = true;  // with a hole: also the axis
+  int max_iterations = 30;
+};
+
+// Starts from `start` (its centre, radius, blur, axis and hole fraction).
+GrainFit fit_grain(const GrainWindow& window, const HoledSphere& start,
+                   const GrainFitOptions& options = {});
+
+}  // namespace granmem

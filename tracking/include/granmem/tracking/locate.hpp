@@ -1,0 +1,39 @@
+#pragma once
+
+#include <cstddef>
+
+#include "granmem/tracking/detections.hpp"
+#include "granmem/tracking/stack.hpp"
+
+namespace granmem {
+
+struct LocateOptions {
+  double diameter = 0;         // grain diameter in voxels along x (the pixel size); required
+  bool dark_grains = true;     // bright fluid, dark grains with bright holes
+  double hole_fraction = 0.3;  // hole diameter over grain diameter; 0: no hole
+  bool correct_illumination = true;
+  int beam_axis = 0;              // the laser's path: 0 along x, 1 along y
+  bool fit_axis = true;           // fit the hole's axis too (with a hole)
+  double min_contrast = 0.4;      // fitted fluid - grain level, normalised; below: rejected
+  double radius_tolerance = 0.3;  // fitted radius within (1 +- this) x the nominal
+  int passes = 2;  // refinement passes; from the second on, neighbours are in the model
+  // Searches of what the found grains leave unexplained, for grains the candidates missed.
+  int search_rounds = 2;
+};
+
+struct LocateSummary {
+  std::size_t candidates = 0, located = 0, rejected = 0, on_edge = 0;
+  // Wall-clock time in total and in each stage: illumination, candidates, model fits.
+  double seconds = 0, seconds_illumination = 0, seconds_candidates = 0, seconds_fits = 0;
+};
+
+// Every grain of a scan: candidates from the smoothed grain fraction (candidates.hpp), then
+// a blurred holed sphere fitted to each grain's voxels with Ceres (grain_fit.hpp): first
+// with the voxels nearer another candidate left out, then with the neighbours' fitted
+// spheres in the model, since in a dense packing neighbours touch and would otherwise pull
+// the fit. Centroids are biased there and lock on the voxel grid; the model fit is not.
+// `stack` is normalised in place (illumination.hpp). Positions, radii in the stack's
+// unit when it has a voxel size, else in voxels; anisotropic voxels handled throughout.
+Detections locate(Stack& stack, const LocateOptions& options, LocateSummary* summary = nullptr);
+
+}  // namespace granmem

@@ -1,0 +1,201 @@
+#include "granmem/tracking/candidates.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "granmem/tracking/illumination.hpp"
+
+namespace granmem {
+namespace {
+
+// A float volume, x fastest.
+struct Volume {
+  std::int64_t nx = 0, ny = 0, nz = 0;
+  std::vector<float> v;
+  float& at(std::int64_t x, std::int64_t y, std::int64_t z) {
+    return v[std::size_t((z * ny + y) * nx + x)];
+  }
+  float at(std::int64_t x, std::int64_t y, std::int64_t z) const {
+    return v[std::size_t((z * ny + y) * nx + x)];
+  }
+};
+
+// Gaussian smoothing along one axis (clamped at the borders), in place.
+void smooth_axis(Volume& vol, int axis, double sigma) {
+  if (sigma < 0.3) return;
+  const int half = int(std::ceil(3 * sigma));
+  std::vector<float> kernel(std::size_t(2 * half + 1));
+  double sum = 0;
+  for (int k = -half; k <= half; ++k)
+    sum += kernel[std::size_t(k + half)] = float(std::exp(-0.5 * k * k / (sigma * sigma)));
+  for (float& k : kernel)
+    k = float(k / sum);
+  const std::int64_t n[3] = {vol.nx, vol.ny, vol.nz};
+  const std::int64_t len = n[axis];
+  const std::int64_t a = axis == 0 ? 1 : 0, b = axis == 2 ? 1 : 2;  // the other two axes
+  const std::int64_t stride = axis == 0 ? 1 : axis == 1 ? vol.nx : vol.nx * vol.ny;
+#pragma omp parallel
+  {
+    std::vector<float> line(static_cast<std::size_t>(len));
+#pragma omp for collapse(2) schedule(static)
+    for (std::int64_t j = 0; j < n[b]; ++j) {
+      for (std::int64_t i = 0; i < n[a]; ++i) {
+        std::int64_t idx[3] = {0, 0, 0};
+        idx[a] = i;
+        idx[b] = j;
+        float* base = vol.v.data() + (idx[2] * vol.ny + idx[1]) * vol.nx + idx[0];
+        for (std::int64_t s = 0; s < len; ++s)
+          line[std::size_t(s)] = base[s * stride];
+        for (std::int64_t s = 0; s < len; ++s) {
+          float acc = 0;
+          for (int k = -half; k <= half; ++k) {
+            const std::int64_t t = std::clamp<std::int64_t>(s + k, 0, len - 1);
+            acc += kernel[std::size_t(k + half)] * line[std::size_t(t)];
+          }
+          base[s * stride] = acc;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const CandidateOptions& o,
+                                             const std::vector<HoledSphere>* found,
+                                             const Eigen::Vector3d& voxel_size) {
+  // Grain fraction binned by b voxels along each axis, b keeping six or more bins per
+  // diameter: less memory and work, and neighbours still apart.
+  Eigen::Array3i bin;
+  for (int k = 0; k < 3; ++k)
+    bin[k] = std::clamp(int(o.diameter[k] / 6), 1, 4);
+  Volume vol;
+  vol.nx = (stack.nx + bin[0] - 1) / bin[0];
+  vol.ny = (stack.ny + bin[1] - 1) / bin[1];
+  vol.nz = (stack.nz + bin[2] - 1) / bin[2];
+  vol.v.assign(std::size_t(vol.nx * vol.ny * vol.nz), 0.f);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t z = 0; z < vol.nz; ++z) {
+    for (std::int64_t y = 0; y < vol.ny; ++y) {
+      for (std::int64_t x = 0; x < vol.nx; ++x) {
+        double sum = 0;
+        int count = 0;
+        for (std::int64_t Z = z * bin[2]; Z < std::min(stack.nz, (z + 1) * bin[2]); ++Z) {
+          for (std::int64_t Y = y * bin[1]; Y < std::min(stack.ny, (y + 1) * bin[1]); ++Y) {
+            for (std::int64_t X = x * bin[0]; X < std::min(stack.nx, (x + 1) * bin[0]); ++X) {
+              sum += std::clamp(1.0 - fluid_fraction(stack.at(X, Y, Z)), 0.0, 1.0);
+              ++count;
+            }
+          }
+        }
+        vol.at(x, y, z) = float(sum / count);
+      }
+    }
+  }
+  // Grains already found are taken out of the grain fraction (their model, binned alike),
+  // so that only what they do not explain is left.
+  if (found) {
+    const double per_bin = 1.0 / (bin[0] * bin[1] * bin[2]);
+    for (const HoledSphere& g : *found) {
+      const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
+      const Eigen::Vector3d reach =
+          Eigen::Vector3d::Constant(g.radius + 3 * g.blur).cwiseQuotient(voxel_size);
+      const Eigen::Vector3d lo = (c - reach).array().ceil().max(0.0);
+      const Eigen::Vector3d hi = (c + reach).array().floor().min(
+          Eigen::Array3d(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1)));
+      for (auto Z = std::int64_t(lo.z()); Z <= std::int64_t(hi.z()); ++Z) {
+        for (auto Y = std::int64_t(lo.y()); Y <= std::int64_t(hi.y()); ++Y) {
+          for (auto X = std::int64_t(lo.x()); X <= std::int64_t(hi.x()); ++X) {
+            const Eigen::Vector3d p =
+                Eigen::Vector3d(double(X), double(Y), double(Z)).cwiseProduct(voxel_size);
+            vol.at(X / bin[0], Y / bin[1], Z / bin[2]) -= float(per_bin * g.value(p));
+          }
+        }
+      }
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis)
+    smooth_axis(vol, axis, 0.25 * o.diameter[axis] / bin[axis]);
+
+  struct Peak {
+    Eigen::Vector3d x;
+    float response;
+  };
+  std::vector<std::vector<Peak>> by_slice(std::size_t(vol.nz));
+#pragma omp parallel for schedule(dynamic, 2)
+  for (std::int64_t z = 0; z < vol.nz; ++z) {
+    for (std::int64_t y = 0; y < vol.ny; ++y) {
+      for (std::int64_t x = 0; x < vol.nx; ++x) {
+        const float c = vol.at(x, y, z);
+        if (c < o.min_response) continue;
+        bool peak = true;
+        for (int dz = -1; dz <= 1 && peak; ++dz) {
+          for (int dy = -1; dy <= 1 && peak; ++dy) {
+            for (int dx = -1; dx <= 1 && peak; ++dx) {
+              if (!dx && !dy && !dz) continue;
+              const std::int64_t X = x + dx, Y = y + dy, Z = z + dz;
+              if (X < 0 || Y < 0 || Z < 0 || X >= vol.nx || Y >= vol.ny || Z >= vol.nz) continue;
+              const float n = vol.at(X, Y, Z);
+              // Ties go to the first in memory order, so a plateau gives one peak.
+              if (n > c ||
+                  (n == c && (Z * vol.ny + Y) * vol.nx + X < (z * vol.ny + y) * vol.nx + x)) {
+                peak = false;
+              }
+            }
+          }
+        }
+        if (!peak) continue;
+        // Sub-voxel: the vertex of a parabola through the maximum and its two neighbours.
+        Eigen::Vector3d at = Eigen::Vector3d(double(x), double(y), double(z));
+        const std::int64_t idx[3] = {x, y, z}, n[3] = {vol.nx, vol.ny, vol.nz};
+        for (int k = 0; k < 3; ++k) {
+          if (idx[k] == 0 || idx[k] == n[k] - 1) continue;
+          std::int64_t lo[3] = {x, y, z}, hi[3] = {x, y, z};
+          --lo[k];
+          ++hi[k];
+          const double m = vol.at(lo[0], lo[1], lo[2]), p = vol.at(hi[0], hi[1], hi[2]);
+          const double curvature = m - 2 * c + p;
+          if (curvature < 0) at[k] += std::clamp(0.5 * (m - p) / curvature, -0.5, 0.5);
+        }
+        // Back to the full grid: bin k covers voxels b k ... b k + b - 1.
+        const Eigen::Array3d b = bin.cast<double>();
+        by_slice[std::size_t(z)].push_back({(b * at.array() + 0.5 * (b - 1)).matrix(), c});
+      }
+    }
+  }
+  std::vector<Peak> peaks;
+  for (auto& f : by_slice)
+    peaks.insert(peaks.end(), f.begin(), f.end());
+  std::stable_sort(peaks.begin(), peaks.end(),
+                   [](const Peak& a, const Peak& b) { return a.response > b.response; });
+
+  // Strongest first; a grid of cells one separation wide finds the close ones.
+  const Eigen::Vector3d separation = o.min_separation * o.diameter;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
+  auto key = [&](const Eigen::Vector3i& c) {
+    return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
+  };
+  std::vector<Eigen::Vector3d> kept;
+  for (const Peak& p : peaks) {
+    const Eigen::Vector3i cell = p.x.cwiseQuotient(separation).array().floor().cast<int>();
+    bool close = false;
+    for (int dz = -1; dz <= 1 && !close; ++dz) {
+      for (int dy = -1; dy <= 1 && !close; ++dy) {
+        for (int dx = -1; dx <= 1 && !close; ++dx) {
+          const auto it = grid.find(key(cell + Eigen::Vector3i(dx, dy, dz)));
+          if (it == grid.end()) continue;
+          for (std::size_t k : it->second) {
+            if ((kept[k] - p.x).cwiseQuotient(separation).squaredNorm() < 1) close = true;
+          }
+        }
+      }
+    }
+    if (close) continue;
+    grid[key(cell)].push_back(kept.size());
+    kept.push_back(p.x);
+  }
+  return kept;
+}
+
+}  // namespace granmem

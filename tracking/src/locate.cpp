@@ -1,0 +1,313 @@
+#include "granmem/tracking/locate.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <unordered_map>
+
+#include "granmem/core/error.hpp"
+#include "granmem/tracking/candidates.hpp"
+#include "granmem/tracking/grain_fit.hpp"
+#include "granmem/tracking/illumination.hpp"
+
+namespace granmem {
+namespace {
+
+// Grains near a point, from a grid of cells one diameter wide (physical coordinates).
+class GrainGrid {
+ public:
+  GrainGrid(const std::vector<Eigen::Vector3d>& centres, double cell) : cell_(cell) {
+    for (std::size_t i = 0; i < centres.size(); ++i)
+      cells_[key(index(centres[i]))].push_back(i);
+  }
+  template <class F>
+  void near(const Eigen::Vector3d& p, int reach, F&& visit) const {
+    const Eigen::Vector3i c = index(p);
+    for (int dz = -reach; dz <= reach; ++dz) {
+      for (int dy = -reach; dy <= reach; ++dy) {
+        for (int dx = -reach; dx <= reach; ++dx) {
+          const auto it = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
+          if (it == cells_.end()) continue;
+          for (std::size_t i : it->second)
+            visit(i);
+        }
+      }
+    }
+  }
+
+ private:
+  Eigen::Vector3i index(const Eigen::Vector3d& p) const {
+    return (p / cell_).array().floor().cast<int>();
+  }
+  static std::int64_t key(const Eigen::Vector3i& c) {
+    return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
+  }
+  double cell_;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+};
+
+// The hole's direction, roughly: the principal axis of the fluid seen inside the grain.
+Eigen::Vector3d hole_direction(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<double>& fluid, const Eigen::Vector3d& centre,
+                               double radius) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  double weight = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const Eigen::Vector3d d = points[k] - centre;
+    if (d.norm() > 0.75 * radius || fluid[k] < 0.5) continue;
+    scatter += fluid[k] * d * d.transpose();
+    weight += fluid[k];
+  }
+  if (weight < 3) return Eigen::Vector3d::UnitZ();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter / weight);
+  return eig.eigenvectors().col(2);
+}
+
+// A grain being located: where the candidates saw it, the fit to start the next pass
+// from, the last fit, and whether it is (still) taken for a grain.
+struct Candidate {
+  Eigen::Vector3d found_at = Eigen::Vector3d::Zero();  // physical
+  HoledSphere start;
+  GrainFit fit;
+  bool fitted = false, active = true;
+};
+
+// The voxels within `reach` of grain `s`: with `model_neighbours`, each with how much of it
+// the neighbours leave clear (voxels they cover are left out: they say nothing of this
+// grain); without, only the voxels nearer this grain than any neighbour.
+void window_of(const Stack& stack, const HoledSphere& s, double reach,
+               const std::vector<const HoledSphere*>& near, bool model_neighbours,
+               const Eigen::Vector3d& vs, GrainWindow& window) {
+  const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
+  const Eigen::Vector3d lo = ((s.centre.array() - reach) / vs.array()).ceil().max(0.0);
+  const Eigen::Vector3d hi = ((s.centre.array() + reach) / vs.array()).floor().min(last);
+  window.points.clear();
+  window.intensity.clear();
+  window.clear.clear();
+  for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
+    for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
+      for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
+        const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
+        const double d = (p - s.centre).norm();
+        if (d > reach) continue;
+        double clear = 1;
+        bool theirs = false;
+        for (const HoledSphere* other : near) {
+          if (model_neighbours) {
+            if ((p - other->centre).norm() < other->radius + 4 * other->blur) {
+              clear *= 1 - other->value(p);
+            }
+          } else if ((p - other->centre).norm() < d) {
+            theirs = true;
+            break;
+          }
+        }
+        if (theirs || clear < 1e-3) continue;
+        window.points.push_back(p);
+        window.intensity.push_back(fluid_fraction(stack.at(x, y, z)));
+        if (model_neighbours) window.clear.push_back(clear);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) {
+  auto clock = std::chrono::steady_clock::now();
+  auto lap = [&clock] {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - clock).count();
+    clock = now;
+    return s;
+  };
+  LocateSummary sum;
+  const std::string& where = stack.source.empty() ? std::string("stack") : stack.source;
+  if (!(o.diameter > 0)) throw Error(where + ": the grain diameter must be positive");
+  const Eigen::Vector3d vs = stack.voxel_size.value_or(Eigen::Vector3d::Ones());
+  const Eigen::Vector3d dims(double(stack.nx), double(stack.ny), double(stack.nz));
+  const double diameter = o.diameter * vs.x();  // physical
+  const Eigen::Vector3d diameter_voxels = Eigen::Vector3d::Constant(diameter).cwiseQuotient(vs);
+  if ((diameter_voxels.array() > dims.array()).any()) {
+    throw Error(where + ": grain diameter " + std::to_string(o.diameter) +
+                " voxels is larger than the stack (" + std::to_string(stack.nx) + " x " +
+                std::to_string(stack.ny) + " x " + std::to_string(stack.nz) + ")");
+  }
+  const double radius = 0.5 * diameter;
+  const double hole = o.dark_grains ? o.hole_fraction : 0.0;
+
+  IlluminationOptions light;
+  light.diameter = diameter_voxels[o.beam_axis];
+  light.dark_grains = o.dark_grains;
+  light.beam_axis = o.beam_axis;
+  if (o.correct_illumination) {
+    normalize_illumination(stack, light);
+  } else {
+    normalize_levels(stack, light);
+  }
+  sum.seconds_illumination = lap();
+
+  CandidateOptions co;
+  co.diameter = diameter_voxels;
+  std::vector<Candidate> grains;
+  auto add_candidates = [&](const std::vector<Eigen::Vector3d>& found_at) {
+    for (const Eigen::Vector3d& c : found_at) {
+      Candidate g;
+      g.found_at = c.cwiseProduct(vs);
+      g.start.centre = g.found_at;
+      g.start.radius = radius;
+      g.start.blur = 0.6 * vs.x();
+      g.start.hole = hole;
+      grains.push_back(g);
+    }
+  };
+  add_candidates(find_candidates(stack, co));
+  sum.seconds_candidates = lap();
+
+  // One fit of every active grain that `refit` selects: with the voxels nearer another
+  // grain left out or, once the neighbours are known, with them in the model. Each reads
+  // its neighbours as the last pass left them, so the order of the fits does not matter.
+  auto fit_pass = [&](bool model_neighbours, auto refit) {
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<std::size_t> ids;
+    for (std::size_t i = 0; i < grains.size(); ++i) {
+      if (grains[i].active && (grains[i].fitted || !model_neighbours)) {
+        centres.push_back(grains[i].start.centre);
+        ids.push_back(i);
+      }
+    }
+    const GrainGrid grid(centres, diameter);
+    std::vector<GrainFit> fits(grains.size());
+#pragma omp parallel
+    {
+      GrainWindow window;
+      std::vector<const HoledSphere*> near;
+#pragma omp for schedule(dynamic, 16)
+      for (std::size_t i = 0; i < grains.size(); ++i) {
+        if (!grains[i].active || !refit(i)) continue;
+        const HoledSphere& s = grains[i].start;
+        const double reach = s.radius + 3 * s.blur + 0.5 * vs.maxCoeff();
+        near.clear();
+        grid.near(s.centre, 2, [&](std::size_t k) {
+          const HoledSphere& other = grains[ids[k]].start;
+          if (ids[k] != i && (other.centre - s.centre).norm() < 2 * reach + radius) {
+            near.push_back(&other);
+          }
+        });
+        window_of(stack, s, reach, near, model_neighbours, vs, window);
+        HoledSphere from = s;
+        if (!grains[i].fitted && hole > 0) {
+          from.axis = hole_direction(window.points, window.intensity, s.centre, s.radius);
+        }
+        GrainFitOptions fo;
+        fo.fit_axis = o.fit_axis;
+        if (window.points.size() > 20) fits[i] = fit_grain(window, from, fo);
+      }
+    }
+    for (std::size_t i = 0; i < grains.size(); ++i) {
+      if (!grains[i].active || !refit(i)) continue;
+      Candidate& g = grains[i];
+      g.fit = fits[i];
+      g.fitted = true;
+      if (g.fit.converged && g.fit.sphere.centre.allFinite()) g.start = g.fit.sphere;
+    }
+  };
+
+  // Keeps the fits that look like grains; of two that found the same grain, the better.
+  auto quality = [](const GrainFit& f) {
+    const double contrast = f.fluid - f.grain;
+    return contrast > 0 ? std::clamp(1 - f.rms / contrast, 0.0, 1.0) : 0.0;
+  };
+  auto select = [&] {
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < grains.size(); ++i)
+      if (grains[i].active) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return quality(grains[a].fit) > quality(grains[b].fit);
+    });
+    std::vector<Eigen::Vector3d> kept;
+    for (std::size_t i : order) {
+      const GrainFit& f = grains[i].fit;
+      const bool grain_like = f.converged && f.fluid - f.grain >= o.min_contrast &&
+                              std::abs(f.sphere.radius / radius - 1) <= o.radius_tolerance &&
+                              (f.sphere.centre - grains[i].found_at).norm() < radius;
+      const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const auto& c) {
+        return (c - f.sphere.centre).norm() < 0.5 * diameter;
+      });
+      grains[i].active = grain_like && !duplicate;
+      if (grains[i].active) kept.push_back(f.sphere.centre);
+    }
+  };
+  auto all = [](std::size_t) { return true; };
+
+  fit_pass(false, all);
+  select();
+  for (int pass = 1; pass < o.passes; ++pass) {
+    fit_pass(true, all);
+    select();
+  }
+  // Grains the candidates missed (a maximum merged with a neighbour's, a fit drawn onto a
+  // neighbour) are what the found grains leave unexplained: look for them there.
+  for (int round = 0; round < o.search_rounds; ++round) {
+    std::vector<HoledSphere> found;
+    for (const Candidate& g : grains)
+      if (g.active) found.push_back(g.start);
+    const GrainGrid grid(
+        [&] {
+          std::vector<Eigen::Vector3d> c;
+          for (const HoledSphere& f : found)
+            c.push_back(f.centre);
+          return c;
+        }(),
+        diameter);
+    std::vector<Eigen::Vector3d> hidden;
+    for (const Eigen::Vector3d& c : find_candidates(stack, co, &found, vs)) {
+      bool near_found = false;
+      grid.near(c.cwiseProduct(vs), 1, [&](std::size_t k) {
+        near_found |= (found[k].centre - c.cwiseProduct(vs)).norm() < 0.5 * diameter;
+      });
+      if (!near_found) hidden.push_back(c);
+    }
+    if (hidden.empty()) break;
+    const std::size_t first_new = grains.size();
+    add_candidates(hidden);
+    for (std::size_t i = first_new; i < grains.size(); ++i)
+      grains[i].fitted = false;
+    // The new ones among the found, then all again (the found were fitted without them).
+    fit_pass(true, [&](std::size_t i) { return i >= first_new; });
+    fit_pass(true, all);
+    select();
+  }
+  sum.seconds_fits = lap();
+
+  sum.candidates = grains.size();
+  Detections d;
+  d.has_axis = hole > 0 && o.fit_axis;
+  d.source = stack.source;
+  d.length_unit = stack.voxel_size ? stack.unit : "voxel";
+  d.voxel_size = stack.voxel_size;
+  for (const Candidate& g : grains) {
+    if (!g.active) continue;
+    const GrainFit& f = g.fit;
+    const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs);
+    const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(f.sphere.radius).cwiseQuotient(vs);
+    const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
+                      ((voxel + r_voxels).array() > dims.array() - 0.5).any();
+    sum.on_edge += edge;
+    // Physical units when the voxel size is known, voxels otherwise (vs = 1 then).
+    d.add(f.sphere.centre, f.sphere.radius, quality(f), edge);
+    if (d.has_axis) {
+      const auto row = Eigen::Index(d.size() - 1);
+      d.axis.row(row) = f.sphere.axis.transpose();
+      d.axis_quality[d.size() - 1] = quality(f);
+    }
+  }
+  sum.rejected = sum.candidates - d.size();
+  sum.located = d.size();
+  sum.seconds = sum.seconds_illumination + sum.seconds_candidates + sum.seconds_fits + lap();
+  if (summary) *summary = sum;
+  return d;
+}
+
+}  // namespace granmem

@@ -13,6 +13,8 @@ void add_info(CLI::App& app);
 void add_analyze(CLI::App& app);
 void add_export(CLI::App& app);
 void add_simulate(CLI::App& app);
+void add_locate(CLI::App& app);
+void add_track(CLI::App& app);
 void add_render(CLI::App& app);
 void add_link(CLI::App& app);
 

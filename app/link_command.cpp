@@ -12,6 +12,7 @@
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/link.hpp"
 #include "parse.hpp"
+#include "tracking_steps.hpp"
 
 namespace granmem::app {
 namespace {
@@ -57,12 +58,102 @@ Table unlinked_table(const Trajectories& run, const LinkSummary& summary,
 
 }  // namespace
 
+void add_link_options(CLI::App* cmd, LinkArgs& args) {
+  cmd->add_option("--max-displacement", args.max_displacement,
+                  "largest distance of a grain from where it is expected, in the detections' "
+                  "unit or with a unit (0.4mm); auto: 0.7 median grain diameter")
+      ->capture_default_str();
+  cmd->add_option("--memory", args.memory, "scans a grain may go unseen and still rejoin its track")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_flag("--no-drift", args.no_drift,
+                "do not estimate the collective motion (drift, uniform deformation, local "
+                "displacement field) between scans");
+  cmd->add_option("--report", args.report,
+                  "CSV of what could not be linked: tracks lost and detections starting a track");
+}
+
+void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
+                    const LinkArgs& args, const std::string& out, const CLI::App& cmd) {
+  // Detections located one stack at a time all say frame 0: number them as given.
+  bool same_frame = true;
+  for (const Detections& d : scans)
+    same_frame = same_frame && d.frame == scans.front().frame;
+  if (same_frame && scans.size() > 1) {
+    for (std::size_t t = 0; t < scans.size(); ++t)
+      scans[t].frame = std::int64_t(t);
+    std::cerr << "granmem: note: every scan says frame " << scans.front().frame << ": numbered 0.."
+              << scans.size() - 1 << " in the order given\n";
+  }
+  const std::string unit = scans.front().length_unit;
+  for (std::size_t t = 1; t < scans.size(); ++t) {
+    if (scans[t].length_unit != unit) {
+      throw Error(names[t] + ": lengths in " + scans[t].length_unit + ", but " + names[0] + " in " +
+                  unit + ": all scans must use one length unit");
+    }
+  }
+
+  LinkOptions options;
+  if (args.max_displacement != "auto") {
+    options.max_displacement = parse_length(args.max_displacement, unit, "--max-displacement");
+  }
+  options.memory = args.memory;
+  options.estimate_drift = !args.no_drift;
+  options.local_field = !args.no_drift;
+
+  LinkSummary summary;
+  Trajectories run = link_scans(scans, options, &summary);
+  for (const auto& [key, value] : used_options(cmd))
+    run.header.parameters[key] = value;
+
+  // Everything is written under temporary names first, then renamed into place.
+  TrajectoryWriter writer(out, run.header);
+  for (const Frame& frame : run.frames)
+    writer.append(frame);
+  std::optional<AtomicFile> report;
+  if (!args.report.empty()) {
+    report.emplace(args.report);
+    write_csv(unlinked_table(run, summary, scans), report->temp_path(),
+              {"granmem link: what could not be linked, lengths in " + unit,
+               "lost=1: track seen in the scan before (at x,y,z) and not found in this frame",
+               "lost=0: detection of this frame starting a new track"});
+  }
+  writer.commit();
+  if (report) report->commit();
+
+  std::cout << "linked " << scans.size() << " scans: " << summary.tracks
+            << " tracks, max displacement " << summary.max_displacement << " " << unit << "\n";
+  std::cout << std::setw(7) << "frame" << std::setw(9) << "grains" << std::setw(10) << "linked"
+            << std::setw(8) << "from_mem" << std::setw(9) << "started" << std::setw(8) << "lost"
+            << std::setw(7) << "kept" << std::setw(7) << "ended"
+            << "  drift [" << unit << "], rms residual\n";
+  for (const ScanLinks& r : summary.scans) {
+    std::cout << std::setw(7) << r.frame << std::setw(9) << r.detections;
+    std::ostringstream linked;
+    if (r.previous > 0) {
+      linked << std::fixed << std::setprecision(2) << 100 * r.linked_fraction() << "%";
+    } else {
+      linked << "-";
+    }
+    std::cout << std::setw(10) << linked.str() << std::setw(8) << r.relinked << std::setw(9)
+              << r.started << std::setw(8) << r.unlinked << std::setw(7) << r.kept << std::setw(7)
+              << r.ended;
+    if (r.previous > 0) {
+      std::cout << "  " << vector_text(r.mean_displacement) << ", " << std::setprecision(3)
+                << r.rms_residual;
+    }
+    std::cout << "\n";
+  }
+  std::cout << "wrote " << out << " and " << xdmf_path(out).string();
+  if (report) std::cout << " and " << args.report;
+  std::cout << "\n";
+}
+
 void add_link(CLI::App& app) {
   struct Args {
     std::vector<std::string> scans;
-    std::string out, max_displacement = "auto", report;
-    int memory = LinkOptions{}.memory;
-    bool no_drift = false;
+    std::string out;
+    LinkArgs link;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd =
@@ -71,20 +162,7 @@ void add_link(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
-  cmd->add_option("--max-displacement", args->max_displacement,
-                  "largest distance of a grain from where it is expected, in the detections' "
-                  "unit or with a unit (0.4mm); auto: 0.7 median grain diameter")
-      ->capture_default_str();
-  cmd->add_option("--memory", args->memory,
-                  "scans a grain may go unseen and still rejoin its track")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_flag("--no-drift", args->no_drift,
-                "do not estimate the collective motion (drift, uniform deformation, local "
-                "displacement field) between scans");
-  cmd->add_option("--report", args->report,
-                  "CSV of what could not be linked: tracks lost and detections starting a track");
-
+  add_link_options(cmd, args->link);
   cmd->callback([args, cmd] {
     std::vector<Detections> scans;
     scans.reserve(args->scans.size());
@@ -92,78 +170,7 @@ void add_link(CLI::App& app) {
       scans.push_back(read_detections(path));
       scans.back().source = path;  // names the scan in messages
     }
-    // Detections located one stack at a time all say frame 0: number them as given.
-    bool same_frame = true;
-    for (const Detections& d : scans)
-      same_frame = same_frame && d.frame == scans.front().frame;
-    if (same_frame && scans.size() > 1) {
-      for (std::size_t t = 0; t < scans.size(); ++t)
-        scans[t].frame = std::int64_t(t);
-      std::cerr << "granmem: note: every scan says frame " << scans.front().frame
-                << ": numbered 0.." << scans.size() - 1 << " in the order given\n";
-    }
-    const std::string unit = scans.front().length_unit;
-    for (std::size_t t = 1; t < scans.size(); ++t) {
-      if (scans[t].length_unit != unit) {
-        throw Error(args->scans[t] + ": lengths in " + scans[t].length_unit + ", but " +
-                    args->scans[0] + " in " + unit + ": all scans must use one length unit");
-      }
-    }
-
-    LinkOptions options;
-    if (args->max_displacement != "auto") {
-      options.max_displacement = parse_length(args->max_displacement, unit, "--max-displacement");
-    }
-    options.memory = args->memory;
-    options.estimate_drift = !args->no_drift;
-    options.local_field = !args->no_drift;
-
-    LinkSummary summary;
-    Trajectories run = link_scans(scans, options, &summary);
-    for (const auto& [key, value] : used_options(*cmd))
-      run.header.parameters[key] = value;
-
-    // Everything is written under temporary names first, then renamed into place.
-    TrajectoryWriter writer(args->out, run.header);
-    for (const Frame& frame : run.frames)
-      writer.append(frame);
-    std::optional<AtomicFile> report;
-    if (!args->report.empty()) {
-      report.emplace(args->report);
-      write_csv(unlinked_table(run, summary, scans), report->temp_path(),
-                {"granmem link: what could not be linked, lengths in " + unit,
-                 "lost=1: track seen in the scan before (at x,y,z) and not found in this frame",
-                 "lost=0: detection of this frame starting a new track"});
-    }
-    writer.commit();
-    if (report) report->commit();
-
-    std::cout << "linked " << scans.size() << " scans: " << summary.tracks
-              << " tracks, max displacement " << summary.max_displacement << " " << unit << "\n";
-    std::cout << std::setw(7) << "frame" << std::setw(9) << "grains" << std::setw(10) << "linked"
-              << std::setw(8) << "from_mem" << std::setw(9) << "started" << std::setw(8) << "lost"
-              << std::setw(7) << "kept" << std::setw(7) << "ended"
-              << "  drift [" << unit << "], rms residual\n";
-    for (const ScanLinks& r : summary.scans) {
-      std::cout << std::setw(7) << r.frame << std::setw(9) << r.detections;
-      std::ostringstream linked;
-      if (r.previous > 0) {
-        linked << std::fixed << std::setprecision(2) << 100 * r.linked_fraction() << "%";
-      } else {
-        linked << "-";
-      }
-      std::cout << std::setw(10) << linked.str() << std::setw(8) << r.relinked << std::setw(9)
-                << r.started << std::setw(8) << r.unlinked << std::setw(7) << r.kept << std::setw(7)
-                << r.ended;
-      if (r.previous > 0) {
-        std::cout << "  " << vector_text(r.mean_displacement) << ", " << std::setprecision(3)
-                  << r.rms_residual;
-      }
-      std::cout << "\n";
-    }
-    std::cout << "wrote " << args->out << " and " << xdmf_path(args->out).string();
-    if (report) std::cout << " and " << args->report;
-    std::cout << "\n";
+    link_and_write(std::move(scans), args->scans, args->link, args->out, *cmd);
   });
 }
 

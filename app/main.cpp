@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   granmem::app::add_analyze(app);
   granmem::app::add_export(app);
   granmem::app::add_simulate(app);
+  granmem::app::add_locate(app);
+  granmem::app::add_track(app);
   granmem::app::add_render(app);
   granmem::app::add_link(app);
   try {

@@ -71,4 +71,21 @@ double parse_length(const std::string& text, const std::string& run_unit,
   return convert_length(q.value, q.unit, run_unit);
 }
 
+VoxelSize parse_voxel_size(const std::string& text, const std::string& option) {
+  const std::vector<Quantity> v = parse_quantity_list(text, option);
+  if (v.size() != 1 && v.size() != 3) {
+    throw Error(option + " '" + text + "': expected one size or three (x,y,z), with a unit");
+  }
+  VoxelSize out;
+  out.unit = v.front().unit;
+  for (int a = 0; a < 3; ++a) {
+    const double value = v[v.size() == 1 ? 0 : std::size_t(a)].value;
+    if (!std::isfinite(value) || !(value > 0)) {
+      throw Error(option + " '" + text + "': sizes must be positive");
+    }
+    out.size[a] = value;
+  }
+  return out;
+}
+
 }  // namespace granmem::app

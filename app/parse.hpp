@@ -22,4 +22,12 @@ std::pair<double, double> parse_range(const std::string& text, const std::string
 double parse_length(const std::string& text, const std::string& run_unit,
                     const std::string& option);
 
+// "X[,Y,Z][ unit]" -> a voxel size (one size: cubic voxels), positive, with the unit as
+// given (empty when none).
+struct VoxelSize {
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();
+  std::string unit;
+};
+VoxelSize parse_voxel_size(const std::string& text, const std::string& option);
+
 }  // namespace granmem::app

@@ -10,6 +10,7 @@
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/render.hpp"
 #include "granmem/tracking/stack.hpp"
+#include "parse.hpp"
 
 namespace granmem::app {
 namespace {
@@ -34,27 +35,13 @@ std::vector<double> numbers(const std::string& text, const std::string& option, 
 
 // "X[,Y,Z][ unit]" -> the voxel size in the run's unit.
 Eigen::Vector3d voxel_size(const std::string& text, const std::string& run_unit) {
-  const std::vector<Quantity> v = parse_quantity_list(text, "--voxel-size");
-  if (v.size() != 1 && v.size() != 3) {
-    throw Error("--voxel-size '" + text + "': expected one size or three (x,y,z), with a unit");
+  const VoxelSize v = parse_voxel_size(text, "--voxel-size");
+  if (v.unit.empty() || v.unit == run_unit) return v.size;
+  if (!is_physical_length_unit(v.unit) || !is_physical_length_unit(run_unit)) {
+    throw Error("--voxel-size '" + text + "': cannot convert " + v.unit + " to the run's unit " +
+                run_unit);
   }
-  Eigen::Vector3d size;
-  for (int a = 0; a < 3; ++a) {
-    const Quantity& q = v[v.size() == 1 ? 0 : std::size_t(a)];
-    double value = q.value;
-    if (!q.unit.empty() && q.unit != run_unit) {
-      if (!is_physical_length_unit(q.unit) || !is_physical_length_unit(run_unit)) {
-        throw Error("--voxel-size '" + text + "': cannot convert " + q.unit +
-                    " to the run's unit " + run_unit);
-      }
-      value = convert_length(value, q.unit, run_unit);
-    }
-    if (!std::isfinite(value) || !(value > 0)) {
-      throw Error("--voxel-size '" + text + "': sizes must be positive");
-    }
-    size[a] = value;
-  }
-  return size;
+  return v.size * convert_length(1, v.unit, run_unit);
 }
 
 Beam beam_side(const std::string& text) {

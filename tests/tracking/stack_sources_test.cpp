@@ -82,7 +82,7 @@ TEST_F(SliceFolderTest, SlicesAreReadInNaturalOrderBitForBit) {
 TEST_F(SliceFolderTest, NaturalOrderComparesNumbersByValue) {
   std::vector<std::string> names = {"s10.png", "s2.png", "s1.png", "s02b.png",
                                     "s.png",   "t1.png", "s9.png", "s100.png"};
-  std::sort(names.begin(), names.end(), stack_io::natural_less);
+  std::sort(names.begin(), names.end(), natural_less);
   EXPECT_EQ(names, (std::vector<std::string>{"s.png", "s1.png", "s2.png", "s02b.png", "s9.png",
                                              "s10.png", "s100.png", "t1.png"}));
 }

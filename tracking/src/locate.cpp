@@ -197,11 +197,19 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
         });
         window_of(stack, s, reach, near, model_neighbours, vs, window);
         HoledSphere from = s;
-        if (!grains[i].fitted && hole > 0) {
-          from.axis = hole_direction(window.points, window.intensity, s.centre, s.radius);
-        }
         GrainFitOptions fo;
         fo.fit_axis = o.fit_axis;
+        if (!grains[i].fitted && hole > 0 && window.points.size() > 20) {
+          // The hole's direction is read from the fluid inside the grain, which needs the
+          // centre first: a sphere without hole fitted from the candidate gives it.
+          HoledSphere plain = s;
+          plain.hole = 0;
+          const GrainFit sphere = fit_grain(window, plain, fo);
+          if (sphere.converged && (sphere.sphere.centre - s.centre).norm() < 0.5 * s.radius) {
+            from.centre = sphere.sphere.centre;
+          }
+          from.axis = hole_direction(window.points, window.intensity, from.centre, s.radius);
+        }
         if (window.points.size() > 20) fits[i] = fit_grain(window, from, fo);
       }
     }
@@ -291,7 +299,10 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
     if (!g.active) continue;
     const GrainFit& f = g.fit;
     const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs);
-    const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(f.sphere.radius).cwiseQuotient(vs);
+    // The fitted radius runs small (the blur's curvature shift, ~0.2 voxel at 12 voxels):
+    // with it, grains cut by a fraction of a voxel were not flagged. Not below the nominal.
+    const Eigen::Vector3d r_voxels =
+        Eigen::Vector3d::Constant(std::max(f.sphere.radius, radius)).cwiseQuotient(vs);
     const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
                       ((voxel + r_voxels).array() > dims.array() - 0.5).any();
     sum.on_edge += edge;

@@ -141,36 +141,6 @@ SliceShape read_slice(const fs::path& file, const std::string& where, const Slic
 
 }  // namespace
 
-bool natural_less(const std::string& a, const std::string& b) {
-  std::size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    if (is_digit(a[i]) && is_digit(b[j])) {
-      // Numbers compare by value: without leading zeros, the shorter is the smaller.
-      std::size_t i_end = i, j_end = j;
-      while (i_end < a.size() && is_digit(a[i_end]))
-        ++i_end;
-      while (j_end < b.size() && is_digit(b[j_end]))
-        ++j_end;
-      std::size_t ia = i, jb = j;
-      while (ia + 1 < i_end && a[ia] == '0')
-        ++ia;
-      while (jb + 1 < j_end && b[jb] == '0')
-        ++jb;
-      if (i_end - ia != j_end - jb) return i_end - ia < j_end - jb;
-      const int c = a.compare(ia, i_end - ia, b, jb, j_end - jb);
-      if (c != 0) return c < 0;
-      i = i_end;
-      j = j_end;
-      continue;
-    }
-    if (a[i] != b[j]) return static_cast<unsigned char>(a[i]) < static_cast<unsigned char>(b[j]);
-    ++i;
-    ++j;
-  }
-  if ((i < a.size()) != (j < b.size())) return j < b.size();  // a prefix comes first
-  return a < b;  // equal but for leading zeros: a fixed order all the same
-}
-
 Stack read_slices(const std::vector<fs::path>& slices, const std::optional<Region>& region,
                   const std::string& source) {
   const std::int64_t n = static_cast<std::int64_t>(slices.size());
@@ -249,3 +219,37 @@ Stack read_slice_folder(const fs::path& folder, const std::optional<Region>& reg
 }
 
 }  // namespace granmem::stack_io
+
+namespace granmem {
+
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (stack_io::is_digit(a[i]) && stack_io::is_digit(b[j])) {
+      // Numbers compare by value: without leading zeros, the shorter is the smaller.
+      std::size_t i_end = i, j_end = j;
+      while (i_end < a.size() && stack_io::is_digit(a[i_end]))
+        ++i_end;
+      while (j_end < b.size() && stack_io::is_digit(b[j_end]))
+        ++j_end;
+      std::size_t ia = i, jb = j;
+      while (ia + 1 < i_end && a[ia] == '0')
+        ++ia;
+      while (jb + 1 < j_end && b[jb] == '0')
+        ++jb;
+      if (i_end - ia != j_end - jb) return i_end - ia < j_end - jb;
+      const int c = a.compare(ia, i_end - ia, b, jb, j_end - jb);
+      if (c != 0) return c < 0;
+      i = i_end;
+      j = j_end;
+      continue;
+    }
+    if (a[i] != b[j]) return static_cast<unsigned char>(a[i]) < static_cast<unsigned char>(b[j]);
+    ++i;
+    ++j;
+  }
+  if ((i < a.size()) != (j < b.size())) return j < b.size();  // a prefix comes first
+  return a < b;  // equal but for leading zeros: a fixed order all the same
+}
+
+}  // namespace granmem

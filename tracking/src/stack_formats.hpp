@@ -39,7 +39,5 @@ Stack read_hdf5_stack(const std::filesystem::path& path, const StackReadOptions&
 enum class TiffFormat { automatic, classic, big };
 void write_tiff_stack(const Stack& stack, const std::filesystem::path& path, TiffFormat format);
 
-// Natural order of file names: runs of digits compare as numbers ("s2" < "s10").
-bool natural_less(const std::string& a, const std::string& b);
 
 }  // namespace granmem::stack_io

@@ -74,4 +74,8 @@ Stack read_stack(const std::filesystem::path& source, const StackReadOptions& op
 // ImageJ metadata carrying the voxel size, atomically (temporary file, then rename).
 void write_tiff(const Stack& stack, const std::filesystem::path& path);
 
+// Natural order of names: runs of digits compare as numbers ("scan2" < "scan10"), the
+// order of slice files in a folder and of scans given to `granmem track`.
+bool natural_less(const std::string& a, const std::string& b);
+
 }  // namespace granmem

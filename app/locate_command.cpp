@@ -1,0 +1,194 @@
+#include <algorithm>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/tracking/locate.hpp"
+#include "granmem/tracking/stack.hpp"
+#include "parse.hpp"
+#include "tracking_steps.hpp"
+
+namespace granmem::app {
+namespace {
+
+// "x0,y0,z0,nx,ny,nz" (voxels) -> the box to read.
+Region parse_region(const std::string& text) {
+  std::vector<std::int64_t> v;
+  std::stringstream s(text);
+  for (std::string item; std::getline(s, item, ',');) {
+    std::size_t used = 0;
+    long long n = -1;
+    try {
+      n = std::stoll(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || n < 0) {
+      throw Error("--region '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels");
+    }
+    v.push_back(n);
+  }
+  if (v.size() != 6) throw Error("--region '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels");
+  return Region{v[0], v[1], v[2], v[3], v[4], v[5]};
+}
+
+// The grain diameter in voxels along x: "12" or "12 vox" (or px), or a length with the
+// stack's voxel size.
+double diameter_voxels(const std::string& text, const Stack& stack) {
+  const Quantity q = parse_quantity(text, "--diameter");
+  if (!std::isfinite(q.value) || !(q.value > 0)) {
+    throw Error("--diameter '" + text + "': expected a positive diameter");
+  }
+  if (q.unit.empty() || q.unit == "vox" || q.unit == "voxel" || q.unit == "px") return q.value;
+  if (!is_physical_length_unit(q.unit)) {
+    throw Error("--diameter '" + text + "': unknown unit " + q.unit + " (m, cm, mm, um, vox)");
+  }
+  if (!stack.voxel_size) {
+    throw Error("--diameter '" + text + "': " + stack.source +
+                " has no voxel size: give the diameter in voxels, or --voxel-size");
+  }
+  return convert_length(q.value, q.unit, stack.unit) / stack.voxel_size->x();
+}
+
+}  // namespace
+
+void add_locate_options(CLI::App* cmd, LocateArgs& args) {
+  cmd->add_option("--diameter,-d", args.diameter,
+                  "grain diameter: in voxels along x (12, 12vox) or a length (1.5mm)")
+      ->required();
+  cmd->add_option("--voxel-size", args.voxel_size,
+                  "voxel size x,y,z (or one for cubic voxels) with a unit (0.1,0.1,0.15mm); "
+                  "replaces the file's; without either, positions are in voxels");
+  cmd->add_option("--dataset", args.dataset, "HDF5 sources: the (z,y,x) dataset to read");
+  cmd->add_option("--region", args.region,
+                  "read only the box x0,y0,z0,nx,ny,nz (voxels; 0: to the end)");
+  cmd->add_option("--polarity", args.polarity,
+                  "dark: dark grains with bright holes in bright fluid; bright: bright grains "
+                  "on dark fluid, no hole")
+      ->check(CLI::IsMember({"dark", "bright"}))
+      ->capture_default_str();
+  cmd->add_option("--hole-fraction", args.hole_fraction,
+                  "hole diameter over grain diameter (dark grains); 0: no hole")
+      ->check(CLI::Range(0.0, 0.8))
+      ->capture_default_str();
+  cmd->add_option("--beam", args.beam, "the laser sheet's path across the slices: x or y")
+      ->check(CLI::IsMember({"x", "y"}))
+      ->capture_default_str();
+  cmd->add_option("--passes", args.passes,
+                  "model fits of every grain (neighbours modelled from the second)")
+      ->check(CLI::Range(1, 10))
+      ->capture_default_str();
+  cmd->add_flag("--no-illumination", args.no_illumination,
+                "skip the illumination correction (evenly lit or corrected scans)");
+}
+
+Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame) {
+  StackReadOptions read;
+  read.dataset = args.dataset;
+  if (!args.region.empty()) read.region = parse_region(args.region);
+  if (!args.voxel_size.empty()) {
+    const VoxelSize v = parse_voxel_size(args.voxel_size, "--voxel-size");
+    if (v.unit.empty() || !is_physical_length_unit(v.unit)) {
+      throw Error("--voxel-size '" + args.voxel_size + "': give a unit (m, cm, mm, um)");
+    }
+    read.voxel_size = v.size;
+    read.unit = v.unit;
+  }
+  Stack stack = read_stack(path, read);
+  LocateOptions o;
+  o.diameter = diameter_voxels(args.diameter, stack);
+  o.dark_grains = args.polarity == "dark";
+  o.hole_fraction = o.dark_grains ? args.hole_fraction : 0.0;
+  o.beam_axis = args.beam == "y" ? 1 : 0;
+  o.passes = args.passes;
+  o.correct_illumination = !args.no_illumination;
+  const std::int64_t voxels = stack.nx * stack.ny * stack.nz;
+
+  LocateSummary sum;
+  Detections d = locate(stack, o, &sum);
+  d.frame = frame;
+  d.source = path;
+  // Positions in the whole stack's frame, not the region's.
+  if (read.region) {
+    const Eigen::Vector3d origin(double(read.region->x0), double(read.region->y0),
+                                 double(read.region->z0));
+    const Eigen::Vector3d shift =
+        origin.cwiseProduct(d.voxel_size.value_or(Eigen::Vector3d::Ones()));
+    d.position.rowwise() += shift.transpose();
+  }
+  std::cout << path << ": " << sum.located << " grains (" << sum.on_edge
+            << " cut by the stack's edge) from " << sum.candidates << " candidates, " << std::fixed
+            << std::setprecision(1) << sum.seconds << " s (" << std::setprecision(2)
+            << 1e3 * sum.seconds / double(std::max<std::size_t>(1, sum.located))
+            << " ms per grain, " << std::setprecision(1) << 1e-6 * double(voxels) / sum.seconds
+            << " Mvoxel/s)" << std::defaultfloat << "; lengths in " << d.length_unit
+            << (d.voxel_size ? "" : " (no voxel size given or found)") << "\n";
+  return d;
+}
+
+void add_locate(CLI::App& app) {
+  struct Args {
+    std::string stack, out, csv;
+    std::int64_t frame = 0;
+    LocateArgs locate;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "locate", "Locate every grain of a scan: centre, radius, hole axis, quality");
+  cmd->add_option("stack", args->stack,
+                  "multi-page TIFF, folder of slice images (TIFF/PNG) or HDF5 file")
+      ->required();
+  cmd->add_option("--out,-o", args->out, "detections to write (.h5, or .csv)")->required();
+  cmd->add_option("--csv", args->csv, "also write the detections as CSV");
+  cmd->add_option("--frame", args->frame, "the scan's index, written in the frame column")
+      ->capture_default_str();
+  add_locate_options(cmd, args->locate);
+  cmd->callback([args] {
+    if (!args->csv.empty() && args->csv == args->out) throw Error("--csv and --out name one file");
+    const Detections d = locate_scan(args->stack, args->locate, args->frame);
+    write_detections(d, args->out);
+    if (!args->csv.empty()) write_detections(d, args->csv);
+    std::cout << "wrote " << args->out << (args->csv.empty() ? "" : " and " + args->csv) << "\n";
+  });
+}
+
+void add_track(CLI::App& app) {
+  struct Args {
+    std::vector<std::string> scans;
+    std::string out, detections;
+    LocateArgs locate;
+    LinkArgs link;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "track", "Locate the grains of a series of scans and link them into trajectories");
+  cmd->add_option("scans", args->scans,
+                  "the scans (TIFF, folder of slices or HDF5), taken in the natural order of "
+                  "their names (scan2 before scan10)")
+      ->required();
+  cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
+  cmd->add_option("--detections", args->detections,
+                  "folder to keep each scan's detections in (scan name + .h5)");
+  add_locate_options(cmd, args->locate);
+  add_link_options(cmd, args->link);
+  cmd->callback([args, cmd] {
+    std::vector<std::string> scans = args->scans;
+    std::stable_sort(scans.begin(), scans.end(), natural_less);
+    if (!args->detections.empty()) std::filesystem::create_directories(args->detections);
+    std::vector<Detections> found;
+    for (std::size_t k = 0; k < scans.size(); ++k) {
+      found.push_back(locate_scan(scans[k], args->locate, std::int64_t(k)));
+      if (!args->detections.empty()) {
+        const std::filesystem::path name = std::filesystem::path(scans[k]).filename();
+        write_detections(found.back(),
+                         std::filesystem::path(args->detections) / (name.stem().string() + ".h5"));
+      }
+    }
+    link_and_write(std::move(found), scans, args->link, args->out, *cmd);
+  });
+}
+
+}  // namespace granmem::app

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "granmem/tracking/detections.hpp"
+
+// The two steps of the experimental pipeline as the commands run them: `locate` and
+// `link` each run one, `track` both.
+namespace granmem::app {
+
+struct LocateArgs {
+  std::string diameter, voxel_size, dataset, region, polarity = "dark", beam = "x";
+  double hole_fraction = 0.3;
+  int passes = 2;
+  bool no_illumination = false;
+};
+void add_locate_options(CLI::App* cmd, LocateArgs& args);
+// Reads the stack at `path`, locates its grains (printing a line of what it found) and
+// labels them scan `frame`.
+Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame);
+
+struct LinkArgs {
+  std::string max_displacement = "auto", report;
+  int memory = 2;
+  bool no_drift = false;
+};
+void add_link_options(CLI::App* cmd, LinkArgs& args);
+// Links the scans (`names` for messages), writes the trajectory store `out` with `cmd`'s
+// options as its parameters, and prints the per-scan summary.
+void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
+                    const LinkArgs& args, const std::string& out, const CLI::App& cmd);
+
+}  // namespace granmem::app

@@ -83,7 +83,7 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
   // diameter: less memory and work, and neighbours still apart.
   Eigen::Array3i bin;
   for (int k = 0; k < 3; ++k)
-    bin[k] = std::clamp(int(o.diameter[k] / 6), 1, 4);
+    bin[k] = std::clamp(int(std::lround(o.diameter[k] / 6)), 1, 4);
   Volume vol;
   vol.nx = (stack.nx + bin[0] - 1) / bin[0];
   vol.ny = (stack.ny + bin[1] - 1) / bin[1];

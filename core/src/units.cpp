@@ -8,14 +8,6 @@
 namespace granmem {
 namespace {
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front())))
-    s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back())))
-    s.remove_suffix(1);
-  return s;
-}
-
 struct UnitScale {
   std::string_view name;
   double metres;
@@ -128,6 +120,14 @@ double parse_si(std::string_view text, Dimension dimension, std::string_view def
       std::string(what) + " '" + std::string(text) + "': " +
       (q.unit.empty() ? std::string("needs a unit") : "unit '" + q.unit + "' is not one of") +
       " (" + accepted + ")");
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front())))
+    s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back())))
+    s.remove_suffix(1);
+  return s;
 }
 
 }  // namespace granmem

@@ -12,6 +12,9 @@ struct Quantity {
   std::string unit;  // empty when none was given
 };
 
+// `s` without leading and trailing white space.
+std::string_view trim(std::string_view s);
+
 // Parses "<number>[ ]<unit>". Throws Error naming `what` if the number is bad.
 Quantity parse_quantity(std::string_view text, std::string_view what);
 

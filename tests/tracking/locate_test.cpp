@@ -1,0 +1,179 @@
+#include "granmem/tracking/locate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "checks.hpp"
+#include "granmem/core/error.hpp"
+#include "locate_score.hpp"
+
+// locate against the truth of rendered dense packings (packing fraction 0.58, grains of 12
+// voxels with their holes, RenderOptions' default artefacts: blur, shot and read noise,
+// attenuation, flicker, streaks; 8-bit), cut by the stack's border as real scans are. The
+// accuracy and speed on larger scans are measured by bench/locate_bench.cpp
+// (docs/BENCHMARKS.md).
+namespace granmem {
+namespace {
+
+using testing::error_message;
+using testing::LocateScore;
+using testing::packing_scan;
+using testing::PackingScan;
+using testing::score_locate;
+
+constexpr double kPhi = 0.58;
+
+// Prints what a test measured, for the log.
+void report(const char* what, const LocateScore& s) {
+  std::cout << what << ": " << s.interior_found << "/" << s.interior << " interior grains found, "
+            << s.spurious << " spurious of " << s.detections << " detections; RMS error x "
+            << s.rms.x() << ", y " << s.rms.y() << ", z " << s.rms.z() << " voxel; bias "
+            << s.bias.transpose() << "; locking amplitude " << s.locking.transpose() << "; KS p "
+            << s.ks_p.transpose() << "; axis error median " << s.axis_percentile(0.5)
+            << " deg, 90% " << s.axis_percentile(0.9) << " deg\n";
+}
+
+// Every interior grain found, nothing else, each well within a tenth of a voxel per axis
+// and with no pull towards the voxel grid.
+void expect_accurate(const LocateScore& s) {
+  EXPECT_GT(s.interior, 50u);
+  EXPECT_EQ(s.interior_found, s.interior);
+  EXPECT_EQ(s.spurious, 0u);
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_LT(s.rms[a], 0.1) << "axis " << a;
+    EXPECT_LT(std::abs(s.bias[a]), 0.03) << "axis " << a;
+    EXPECT_LT(s.locking[a], 0.04) << "axis " << a;  // first harmonic vs the fractional part
+    EXPECT_GT(s.ks_p[a], 1e-4) << "axis " << a;     // fractional parts uniform
+  }
+}
+
+// Flags against how far each found grain reaches out of the stack (voxels): those cut by
+// more than `tolerance` flagged, those clear of the border by more than it not.
+void expect_edge_flags(const Detections& d, const Table& truth, const Stack& stack,
+                       const Eigen::Vector3d& voxel_size, double tolerance) {
+  const testing::LocateMatch m = testing::match_locate(d, truth, voxel_size);
+  const Eigen::Vector3d last(double(stack.nx) - 0.5, double(stack.ny) - 0.5,
+                             double(stack.nz) - 0.5);
+  std::size_t cut = 0;
+  for (std::size_t i = 0; i < m.truth.size(); ++i) {
+    if (m.of_grain[i] < 0) continue;
+    const Eigen::Vector3d r = Eigen::Vector3d::Constant(truth["radius"].values[i] * voxel_size.x())
+                                  .cwiseQuotient(voxel_size);
+    const Eigen::Vector3d c = m.truth[i];
+    const double out = std::max(((r - c).array() - 0.5).maxCoeff(), (c + r - last).maxCoeff());
+    const bool flagged = d.edge[std::size_t(m.of_grain[i])] != 0;
+    if (out > tolerance) {
+      ++cut;
+      EXPECT_TRUE(flagged) << "grain at " << c.transpose() << " cut by " << out << " voxel";
+    }
+    if (out < -tolerance) {
+      EXPECT_FALSE(flagged) << "grain at " << c.transpose() << " clear by " << -out << " voxel";
+    }
+  }
+  EXPECT_GT(cut, 10u);
+}
+
+TEST(Locate, DensePackingIsotropicVoxels) {
+  PackingScan scan = packing_scan(220, kPhi, 12, 1, 11);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  const Stack rendered = stack;
+  LocateOptions o;
+  o.diameter = 12;
+  LocateSummary summary;
+  const Detections d = locate(stack, o, &summary);
+  const Eigen::Vector3d vs = *scan.options.voxel_size;
+  // Positions in the stack's unit.
+  EXPECT_EQ(d.length_unit, "mm");
+  ASSERT_TRUE(d.voxel_size.has_value());
+  EXPECT_EQ(*d.voxel_size, vs);
+  EXPECT_EQ(summary.located, d.size());
+  const LocateScore s = score_locate(d, truth, vs);
+  report("d = 12, isotropic", s);
+  expect_accurate(s);
+  expect_edge_flags(d, truth, rendered, vs, 0.25);
+  // Hole axes: the angle between the fitted and the true line.
+  ASSERT_TRUE(d.has_axis);
+  EXPECT_EQ(s.axis_degrees.size(), s.interior_found);
+  EXPECT_LT(s.axis_percentile(0.5), 2.0);
+  EXPECT_LT(s.axis_percentile(0.9), 5.0);
+}
+
+TEST(Locate, DensePackingCoarserSlices) {
+  // Slices 1.5 voxels apart: the grain is 12 voxels across in x and y, 8 slices in z.
+  PackingScan scan = packing_scan(220, kPhi, 12, 1.5, 12);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  ASSERT_TRUE(stack.voxel_size.has_value());
+  EXPECT_DOUBLE_EQ(stack.voxel_size->z() / stack.voxel_size->x(), 1.5);
+  const Stack rendered = stack;
+  LocateOptions o;
+  o.diameter = 12;  // along x
+  const Detections d = locate(stack, o);
+  const Eigen::Vector3d vs = *scan.options.voxel_size;
+  EXPECT_EQ(d.length_unit, "mm");
+  // Radii in the stack's unit: a diameter of 1 mm.
+  double mean_radius = 0;
+  for (double r : d.radius)
+    mean_radius += r / double(d.size());
+  EXPECT_NEAR(mean_radius, 0.5, 0.05);
+  const LocateScore s = score_locate(d, truth, vs);
+  report("d = 12, slices 1.5x coarser (errors in slices along z)", s);
+  expect_accurate(s);
+  expect_edge_flags(d, truth, rendered, vs, 0.25);
+  EXPECT_LT(s.axis_percentile(0.5), 4.0);
+}
+
+TEST(Locate, WithoutVoxelSizeInVoxels) {
+  PackingScan scan = packing_scan(120, kPhi, 12, 1, 13);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  stack.voxel_size.reset();
+  LocateOptions o;
+  o.diameter = 12;
+  const Detections d = locate(stack, o);
+  EXPECT_EQ(d.length_unit, "voxel");
+  EXPECT_FALSE(d.voxel_size.has_value());
+  const LocateScore s = score_locate(d, truth, Eigen::Vector3d::Ones());
+  report("d = 12, no voxel size", s);
+  expect_accurate(s);
+}
+
+TEST(Locate, BrightGrainsWithoutHoles) {
+  PackingScan scan = packing_scan(180, kPhi, 12, 1, 14);
+  scan.options.polarity = Polarity::bright_grains;
+  scan.options.hole_fraction = 0;
+  for (RenderedGrain& g : scan.grains)
+    g.axis = Eigen::Vector3d::Constant(NAN);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  LocateOptions o;
+  o.diameter = 12;
+  o.dark_grains = false;
+  o.hole_fraction = 0;
+  const Detections d = locate(stack, o);
+  EXPECT_FALSE(d.has_axis);
+  const LocateScore s = score_locate(d, truth, *scan.options.voxel_size);
+  report("d = 12, bright grains, no holes", s);
+  expect_accurate(s);
+}
+
+TEST(Locate, DiameterLargerThanTheStackIsAnError) {
+  Stack stack(20, 20, 10);
+  stack.source = "tiny.tif";
+  LocateOptions o;
+  o.diameter = 12;  // fits in x and y, not in z
+  const std::string message = error_message([&] { locate(stack, o); });
+  EXPECT_NE(message.find("tiny.tif"), std::string::npos) << message;
+  EXPECT_NE(message.find("larger than the stack"), std::string::npos) << message;
+  // With slices twice as far apart, 12 voxels across is 6 slices: it fits.
+  stack.voxel_size = Eigen::Vector3d(1, 1, 2);
+  stack.unit = "um";
+  EXPECT_NO_THROW(locate(stack, o));
+  o.diameter = 0;
+  EXPECT_NE(error_message([&] { locate(stack, o); }).find("positive"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace granmem

@@ -109,6 +109,39 @@ class GranmemTest : public TempDirTest {
     return r;
   }
 
+  // Runs granmem expecting a clean failure whose single stderr line holds every `expected`.
+  void expect_clean_failure(const std::vector<std::string>& args,
+                            const std::vector<std::string>& expected) {
+    std::string cmd = "granmem";
+    for (const std::string& a : args)
+      cmd += " " + a;
+    SCOPED_TRACE(cmd);
+    const auto before = snapshot(work());
+    const RunResult r = granmem(args);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_LT(r.exit_code, 128) << "killed by a signal";
+    EXPECT_EQ(r.out, "");
+    const std::vector<std::string> lines = r.err_lines();
+    EXPECT_EQ(lines.size(), 1u) << "stderr:\n" << r.err;
+    EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n') << r.err;
+    const std::string first = lines.empty() ? "" : lines[0];
+    EXPECT_EQ(first.rfind("granmem: error: ", 0), 0u) << first;
+    for (const std::string& e : expected)
+      EXPECT_NE(first.find(e), std::string::npos) << "expected '" << e << "' in: " << first;
+    // Nothing written, nothing left behind (no .<name>.tmp-*), nothing changed.
+    const auto after = snapshot(work());
+    for (const auto& [name, text] : after) {
+      EXPECT_TRUE(before.count(name)) << "left behind: " << name;
+    }
+    for (const auto& [name, text] : before) {
+      const auto it = after.find(name);
+      if (it == after.end())
+        ADD_FAILURE() << "removed: " << name;
+      else
+        EXPECT_TRUE(it->second == text) << "changed: " << name;
+    }
+  }
+
   // Reads `columns` of a CSV written by granmem.
   static Table read_columns(const std::filesystem::path& csv,
                             const std::vector<std::string>& columns) {

@@ -65,14 +65,12 @@ Eigen::Vector3d hole_direction(const std::vector<Eigen::Vector3d>& points,
   }
   if (inside.size() < 10) return Eigen::Vector3d::UnitZ();
   mean /= double(inside.size());
+  const bool seen_bright = bright >= 3;
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (std::size_t k : inside) {
+    const double weight = seen_bright ? (fluid[k] >= 0.5 ? fluid[k] : 0.0) : fluid[k] - mean;
     const Eigen::Vector3d d = points[k] - centre;
-    if (bright >= 3) {
-      if (fluid[k] >= 0.5) scatter += fluid[k] * d * d.transpose();
-    } else {
-      scatter += (fluid[k] - mean) * d * d.transpose();
-    }
+    scatter += weight * d * d.transpose();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
   return eig.eigenvectors().col(2);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "granmem/tracking/detections.hpp"
+#include "granmem/tracking/locate.hpp"
 
 // The two steps of the experimental pipeline as the commands run them: `locate` and
 // `link` each run one, `track` both.
@@ -13,8 +14,8 @@ namespace granmem::app {
 
 struct LocateArgs {
   std::string diameter, voxel_size, dataset, region, polarity = "dark", beam = "x";
-  double hole_fraction = 0.3;
-  int passes = 2;
+  double hole_fraction = LocateOptions{}.hole_fraction;
+  int passes = LocateOptions{}.passes;
   bool no_illumination = false;
 };
 void add_locate_options(CLI::App* cmd, LocateArgs& args);

@@ -74,6 +74,11 @@ Volume ball_mean(const Volume& vol, const Eigen::Array3d& semi) {
   return out;
 }
 
+// A hash of a grid cell's integer coordinates.
+std::int64_t cell_key(const Eigen::Vector3i& c) {
+  return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
+}
+
 }  // namespace
 
 std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const CandidateOptions& o,
@@ -184,15 +189,39 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
   std::vector<Peak> peaks;
   for (auto& f : by_slice)
     peaks.insert(peaks.end(), f.begin(), f.end());
+  if (found) {
+    // Cells one diameter wide, in voxels.
+    const auto cell_of = [&](const Eigen::Vector3d& x) -> Eigen::Vector3i {
+      return x.cwiseQuotient(o.diameter).array().floor().cast<int>();
+    };
+    std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> near_found;
+    for (const HoledSphere& g : *found) {
+      const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
+      near_found[cell_key(cell_of(c))].push_back(c);
+    }
+    const auto explained = [&](const Peak& p) {
+      const Eigen::Vector3i cell = cell_of(p.x);
+      for (int dz = -1; dz <= 1; ++dz) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const auto it = near_found.find(cell_key(cell + Eigen::Vector3i(dx, dy, dz)));
+            if (it == near_found.end()) continue;
+            for (const Eigen::Vector3d& c : it->second) {
+              if ((c - p.x).cwiseQuotient(o.diameter).norm() < 0.5) return true;
+            }
+          }
+        }
+      }
+      return false;
+    };
+    peaks.erase(std::remove_if(peaks.begin(), peaks.end(), explained), peaks.end());
+  }
   std::stable_sort(peaks.begin(), peaks.end(),
                    [](const Peak& a, const Peak& b) { return a.response > b.response; });
 
   // Strongest first; a grid of cells one separation wide finds the close ones.
   const Eigen::Vector3d separation = o.min_separation * o.diameter;
   std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
-  auto key = [&](const Eigen::Vector3i& c) {
-    return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
-  };
   std::vector<Eigen::Vector3d> kept;
   for (const Peak& p : peaks) {
     const Eigen::Vector3i cell = p.x.cwiseQuotient(separation).array().floor().cast<int>();
@@ -200,7 +229,7 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
     for (int dz = -1; dz <= 1 && !close; ++dz) {
       for (int dy = -1; dy <= 1 && !close; ++dy) {
         for (int dx = -1; dx <= 1 && !close; ++dx) {
-          const auto it = grid.find(key(cell + Eigen::Vector3i(dx, dy, dz)));
+          const auto it = grid.find(cell_key(cell + Eigen::Vector3i(dx, dy, dz)));
           if (it == grid.end()) continue;
           for (std::size_t k : it->second) {
             if ((kept[k] - p.x).cwiseQuotient(separation).squaredNorm() < 1) close = true;
@@ -209,7 +238,7 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
       }
     }
     if (close) continue;
-    grid[key(cell)].push_back(kept.size());
+    grid[cell_key(cell)].push_back(kept.size());
     kept.push_back(p.x);
   }
   return kept;

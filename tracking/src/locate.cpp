@@ -177,6 +177,13 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
   add_candidates(find_candidates(stack, co));
   sum.seconds_candidates = lap();
 
+  // A converged fit of the nominal size and a blur under the radius: a blur that wide
+  // smears a grain into its neighbours, and such a fit explains something else (its next
+  // window, three blurs wide, would be huge). Only such fits are started from again.
+  auto shaped_like_a_grain = [&](const GrainFit& f) {
+    return f.converged && f.sphere.centre.allFinite() &&
+           std::abs(f.sphere.radius / radius - 1) <= o.radius_tolerance && f.sphere.blur < radius;
+  };
   // One fit of every active grain that `refit` selects: with the voxels nearer another
   // grain left out or, once the neighbours are known, with them in the model. Each reads
   // its neighbours as the last pass left them, so the order of the fits does not matter.
@@ -230,7 +237,7 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
       Candidate& g = grains[i];
       g.fit = fits[i];
       g.fitted = true;
-      if (g.fit.converged && g.fit.sphere.centre.allFinite()) g.start = g.fit.sphere;
+      if (shaped_like_a_grain(g.fit)) g.start = g.fit.sphere;
     }
   };
 
@@ -249,9 +256,8 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
     std::vector<Eigen::Vector3d> kept;
     for (std::size_t i : order) {
       const GrainFit& f = grains[i].fit;
-      const bool grain_like = f.converged && f.fluid - f.grain >= o.min_contrast &&
-                              std::abs(f.sphere.radius / radius - 1) <= o.radius_tolerance &&
-                              (f.sphere.centre - grains[i].found_at).norm() < radius;
+      const bool grain_like = shaped_like_a_grain(f) && f.fluid - f.grain >= o.min_contrast &&
+                              (f.sphere.centre - grains[i].found_at).norm() < diameter;
       const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const auto& c) {
         return (c - f.sphere.centre).norm() < 0.5 * diameter;
       });
@@ -263,40 +269,38 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
 
   fit_pass(false, all);
   select();
-  for (int pass = 1; pass < o.passes; ++pass) {
-    fit_pass(true, all);
-    select();
-  }
-  // Grains the candidates missed (a maximum merged with a neighbour's, a fit drawn onto a
-  // neighbour) are what the found grains leave unexplained: look for them there.
-  for (int round = 0; round < o.search_rounds; ++round) {
+  // Then, with the neighbours in the model, pass after pass; before each, grains the
+  // candidates missed (a maximum merged with a neighbour's, a fit drawn onto a neighbour)
+  // are looked for in what the found grains leave unexplained, so that no fit is pulled
+  // into an unexplained grain. Each fit reads its neighbours as the last pass left them:
+  // `passes` refit every grain; further searches only the new grains and their neighbours.
+  const int rounds = std::max(o.passes - 1, o.search_rounds);
+  for (int round = 0; round < rounds; ++round) {
     std::vector<HoledSphere> found;
     for (const Candidate& g : grains)
       if (g.active) found.push_back(g.start);
-    const GrainGrid grid(
-        [&] {
-          std::vector<Eigen::Vector3d> c;
-          for (const HoledSphere& f : found)
-            c.push_back(f.centre);
-          return c;
-        }(),
-        diameter);
-    std::vector<Eigen::Vector3d> hidden;
-    for (const Eigen::Vector3d& c : find_candidates(stack, co, &found, vs)) {
-      bool near_found = false;
-      grid.near(c.cwiseProduct(vs), 1, [&](std::size_t k) {
-        near_found |= (found[k].centre - c.cwiseProduct(vs)).norm() < 0.5 * diameter;
-      });
-      if (!near_found) hidden.push_back(c);
-    }
-    if (hidden.empty()) break;
+    const std::vector<Eigen::Vector3d> hidden = round < o.search_rounds
+                                                    ? find_candidates(stack, co, &found, vs)
+                                                    : std::vector<Eigen::Vector3d>{};
+    const bool refit_all = round < o.passes - 1;
+    if (hidden.empty() && !refit_all) break;
     const std::size_t first_new = grains.size();
     add_candidates(hidden);
+    const auto is_new = [&](std::size_t i) { return i >= first_new; };
+    fit_pass(true, is_new);
+    // The grains whose windows reach a new one.
+    std::vector<Eigen::Vector3d> new_centres;
     for (std::size_t i = first_new; i < grains.size(); ++i)
-      grains[i].fitted = false;
-    // The new ones among the found, then all again (the found were fitted without them).
-    fit_pass(true, [&](std::size_t i) { return i >= first_new; });
-    fit_pass(true, all);
+      new_centres.push_back(grains[i].start.centre);
+    const GrainGrid new_grid(new_centres, diameter);
+    const auto near_new = [&](std::size_t i) {
+      bool near = is_new(i);
+      new_grid.near(grains[i].start.centre, 2, [&](std::size_t k) {
+        near |= (new_centres[k] - grains[i].start.centre).norm() < 2 * diameter;
+      });
+      return near;
+    };
+    fit_pass(true, [&](std::size_t i) { return refit_all || near_new(i); });
     select();
   }
   sum.seconds_fits = lap();

@@ -21,6 +21,8 @@ struct CandidateOptions {
 // notwithstanding. Peaks above `min_response` closer than `min_separation` to a stronger
 // one are dropped. With `found` (grains already located, physical coordinates with
 // `voxel_size`), their model is subtracted first: what is left are the grains they hid.
+// Peaks within half a diameter of a found grain (what its fit leaves, not a grain) are
+// dropped before the separation is applied, so that they hide nothing.
 // Returns centres in voxel coordinates, to about a voxel.
 std::vector<Eigen::Vector3d> find_candidates(
     const Stack& normalized, const CandidateOptions& options,

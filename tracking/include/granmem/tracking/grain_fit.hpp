@@ -31,7 +31,7 @@ struct GrainFit {
 
 struct GrainFitOptions {
   bool fit_axis = true;  // with a hole: also the axis
-  int max_iterations = 30;
+  int max_iterations = 40;
 };
 
 // Starts from `start` (its centre, radius, blur, axis and hole fraction).

@@ -16,9 +16,13 @@ struct LocateOptions {
   bool fit_axis = true;           // fit the hole's axis too (with a hole)
   double min_contrast = 0.4;      // fitted fluid - grain level, normalised; below: rejected
   double radius_tolerance = 0.3;  // fitted radius within (1 +- this) x the nominal
-  int passes = 2;  // refinement passes; from the second on, neighbours are in the model
-  // Searches of what the found grains leave unexplained, for grains the candidates missed.
-  int search_rounds = 2;
+  // Model fits of every grain; from the second on, the neighbours are in the model. Each
+  // pass moves a grain less, as its neighbours' fits settle: 4 (at 8 voxels per diameter
+  // the RMS error falls ~25 % from 3 to 4).
+  int passes = 4;
+  // Searches of what the found grains leave unexplained, for grains the candidates missed;
+  // each is followed by a pass over the new grains and their neighbours.
+  int search_rounds = 4;
 };
 
 struct LocateSummary {

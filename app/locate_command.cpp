@@ -77,6 +77,11 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args) {
   cmd->add_option("--beam", args.beam, "the laser sheet's path across the slices: x or y")
       ->check(CLI::IsMember({"x", "y"}))
       ->capture_default_str();
+  cmd->add_option("--axis", args.axis,
+                  "the hole's axis: fitted with the grain model, or the lab's classical "
+                  "estimate (principal axis of the bright hole voxels within 0.8 R)")
+      ->check(CLI::IsMember({"fit", "lab"}))
+      ->capture_default_str();
   cmd->add_option("--passes", args.passes,
                   "model fits of every grain (neighbours modelled from the second)")
       ->check(CLI::Range(1, 10))
@@ -104,6 +109,7 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
   o.hole_fraction = o.dark_grains ? args.hole_fraction : 0.0;
   o.beam_axis = args.beam == "y" ? 1 : 0;
   o.passes = args.passes;
+  o.fit_axis = args.axis == "fit";
   o.correct_illumination = !args.no_illumination;
   const std::int64_t voxels = stack.nx * stack.ny * stack.nz;
 

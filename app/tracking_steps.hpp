@@ -13,7 +13,7 @@
 namespace granmem::app {
 
 struct LocateArgs {
-  std::string diameter, voxel_size, dataset, region, polarity = "dark", beam = "x";
+  std::string diameter, voxel_size, dataset, region, polarity = "dark", beam = "x", axis = "fit";
   double hole_fraction = LocateOptions{}.hole_fraction;
   int passes = LocateOptions{}.passes;
   bool no_illumination = false;

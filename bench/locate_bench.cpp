@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 
+#include "bench_options.hpp"
 #include "granmem/tracking/locate.hpp"
 #include "locate_score.hpp"
 
@@ -32,15 +33,6 @@ namespace {
 
 using namespace granmem;
 using namespace granmem::testing;
-
-std::vector<double> list(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ','))
-    v.push_back(std::stod(item));
-  return v;
-}
 
 double cpu_seconds() {
   rusage u{};
@@ -58,85 +50,49 @@ double peak_rss_mb() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::size_t grains = 2000;
-  double phi = 0.59;
-  std::vector<double> diameters{8, 12, 16}, z_ratios{1, 1.5}, bits{8, 16};
-  int threads = 2;
-  std::uint32_t seed = 1;
+  bench::ScanBenchOptions o;
+  o.out = "locate_bench.csv";
   bool big = false, verbose = false, bright = false;
-  std::string out = "locate_bench.csv";
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--big") {
-      big = true;
-      grains = 20000;
-      diameters = {12};
-      z_ratios = {1};
-      bits = {8};
-      continue;
-    }
-    if (a == "--bright") {
-      bright = true;
-      continue;
-    }
-    if (a == "--verbose") {
-      verbose = true;
-      continue;
-    }
-    if (i + 1 >= argc) {
-      std::cerr << "locate_bench: " << a << " needs a value\n";
-      return 2;
-    }
-    const std::string v = argv[++i];
-    if (a == "--grains")
-      grains = std::size_t(std::stoul(v));
-    else if (a == "--phi")
-      phi = std::stod(v);
-    else if (a == "--diameters")
-      diameters = list(v);
-    else if (a == "--z-ratios")
-      z_ratios = list(v);
-    else if (a == "--bits")
-      bits = list(v);
-    else if (a == "--threads")
-      threads = std::stoi(v);
-    else if (a == "--seed")
-      seed = std::uint32_t(std::stoul(v));
-    else if (a == "--out")
-      out = v;
-    else {
-      std::cerr << "locate_bench: unknown option " << a << "\n";
-      return 2;
-    }
-  }
-  omp_set_num_threads(threads);
+  const bool parsed = bench::parse_options(argc, argv, "locate_bench", o.setters(),
+                                           {{"--big",
+                                             [&] {
+                                               big = true;
+                                               o.grains = 20000;
+                                               o.diameters = {12};
+                                               o.z_ratios = {1};
+                                               o.bits = {8};
+                                             }},
+                                            {"--bright", [&] { bright = true; }},
+                                            {"--verbose", [&] { verbose = true; }}});
+  if (!parsed) return 2;
+  omp_set_num_threads(o.threads);
   using clock = std::chrono::steady_clock;
   auto seconds = [](clock::time_point t) {
     return std::chrono::duration<double>(clock::now() - t).count();
   };
 
-  std::ofstream csv(out);
+  std::ofstream csv(o.out);
   csv << "diameter,z_ratio,bits,grains,interior,interior_found,edge_found,spurious,"
          "interior_flagged_edge,edge_unflagged,rms_x,rms_y,rms_z,bias_x,bias_y,bias_z,"
          "max_x,max_y,max_z,ks_x,ks_y,ks_z,ks_p_x,ks_p_y,ks_p_z,lock_x,lock_y,lock_z,"
          "axis_median_deg,axis_p90_deg,voxels,render_s,locate_s,illumination_s,candidates_s,"
          "fits_s,locate_cpu_s,ms_per_grain,voxels_per_s,peak_rss_mb\n";
-  std::cout << (bright ? "bright grains, no holes; " : "dark grains with holes; ") << "phi " << phi
-            << ", " << threads << " threads, seed " << seed << "\n"
+  std::cout << (bright ? "bright grains, no holes; " : "dark grains with holes; ") << "phi "
+            << o.phi << ", " << o.threads << " threads, seed " << o.seed << "\n"
             << " d  z  bit  grains interior  found%  false%  rms x     y     z  [vox]"
             << "  KS x    y    z  (p min)  lock[vox]  axis med/p90 [deg]  ms/grain  Mvox/s\n";
-  for (double dz : z_ratios) {
-    for (double diameter : diameters) {
+  for (double dz : o.z_ratios) {
+    for (double diameter : o.diameters) {
       const auto t_pack = clock::now();
-      PackingScan scan = packing_scan(grains, phi, diameter, dz, seed);
-      if (bright) {  // bright grains on a dark fluid, no hole seen
+      PackingScan scan = packing_scan(o.grains, o.phi, diameter, dz, o.seed);
+      if (bright) {  // bright o.grains on a dark fluid, no hole seen
         scan.options.polarity = Polarity::bright_grains;
         scan.options.hole_fraction = 0;
         for (RenderedGrain& g : scan.grains)
           g.axis = Eigen::Vector3d::Constant(NAN);
       }
       const double pack_s = seconds(t_pack);
-      for (double b : bits) {
+      for (double b : o.bits) {
         scan.options.bits = int(b);
         Table truth;
         const auto t_render = clock::now();
@@ -157,9 +113,9 @@ int main(int argc, char** argv) {
           for (const std::string& line : describe_misses(d, truth, *scan.options.voxel_size))
             std::cout << "    " << line << "\n";
         }
-        const double ms_per_grain = 1e3 * locate_s / double(grains);
+        const double ms_per_grain = 1e3 * locate_s / double(o.grains);
         std::cout << std::fixed << std::setw(2) << int(diameter) << std::setprecision(1)
-                  << std::setw(4) << dz << std::setw(4) << int(b) << std::setw(8) << grains
+                  << std::setw(4) << dz << std::setw(4) << int(b) << std::setw(8) << o.grains
                   << std::setw(8) << s.interior << std::setprecision(2) << std::setw(8)
                   << 100 * s.interior_fraction() << std::setw(8) << 100 * s.spurious_fraction()
                   << std::setprecision(3) << std::setw(8) << s.rms.x() << std::setw(6) << s.rms.y()
@@ -182,7 +138,7 @@ int main(int argc, char** argv) {
                   << ", edge unflagged " << s.edge_unflagged << ", bias " << s.bias.transpose()
                   << ", max |error| " << s.max_error.transpose() << ", peak RSS " << peak_rss_mb()
                   << " MB\n";
-        csv << diameter << "," << dz << "," << b << "," << grains << "," << s.interior << ","
+        csv << diameter << "," << dz << "," << b << "," << o.grains << "," << s.interior << ","
             << s.interior_found << "," << s.edge_found << "," << s.spurious << ","
             << s.interior_flagged << "," << s.edge_unflagged;
         for (const Eigen::Vector3d* v :
@@ -198,6 +154,6 @@ int main(int argc, char** argv) {
     }
   }
   if (big) std::cout << "peak RSS " << peak_rss_mb() << " MB\n";
-  std::cout << "wrote " << out << "\n";
+  std::cout << "wrote " << o.out << "\n";
   return 0;
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "granmem/core/table.hpp"
+#include "granmem/rotation/hole_contacts.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/render.hpp"
 #include "link_packing.hpp"
@@ -190,6 +191,24 @@ inline LocateMatch match_locate(const Detections& d, const Table& truth,
     r.of_detection[p.detection] = std::int64_t(p.grain);
   }
   return r;
+}
+
+// The true grains touching a neighbour through their hole (hole_contacts.hpp): centres
+// within 2 % of a diameter of touching, radii 0.5 (the packings' diameter is 1).
+inline std::vector<std::uint8_t> true_hole_contacts(const Table& truth, const LocateMatch& m,
+                                                    const Eigen::Vector3d& voxel_size,
+                                                    double hole_fraction) {
+  const std::size_t n = truth.rows();
+  Vectors3 centre(Eigen::Index(n), 3), axis(Eigen::Index(n), 3);
+  for (std::size_t i = 0; i < n; ++i) {
+    centre.row(Eigen::Index(i)) = m.truth[i].cwiseProduct(voxel_size).transpose();
+    axis.row(Eigen::Index(i)) << truth["ax"].values[i], truth["ay"].values[i],
+        truth["az"].values[i];
+  }
+  HoleContactOptions touching;
+  touching.hole_fraction = hole_fraction;
+  touching.gap = 0.02;
+  return hole_contacts(centre, std::vector<double>(n, 0.5), axis, touching);
 }
 
 // Scores the detections of a rendered scan (see match_locate).

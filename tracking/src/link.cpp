@@ -5,12 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <nanoflann.hpp>
 #include <optional>
 #include <sstream>
 #include <utility>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/point_index.hpp"
 #include "granmem/tracking/assignment.hpp"
 
 // Why this method holds in dense packings
@@ -51,60 +51,7 @@ constexpr std::size_t kParallel = 2000;  // fewer grains than this: one thread
 // within reach costs little, as the one-to-one assignment sets it aside.
 constexpr double kDefaultReach = 0.7;
 
-// nanoflann's view of an N x 3 row-major point set.
-struct Cloud {
-  const Vectors3* points = nullptr;
-  std::size_t kdtree_get_point_count() const { return std::size_t(points->rows()); }
-  double kdtree_get_pt(std::size_t i, std::size_t d) const {
-    return (*points)(Eigen::Index(i), Eigen::Index(d));
-  }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>,
-                                                   Cloud, 3, std::uint32_t>;
-using Hits = std::vector<std::pair<std::uint32_t, double>>;  // index, squared distance
-
-// A kd-tree over its own copy of the points (an empty set answers nothing).
-class PointIndex {
- public:
-  explicit PointIndex(Vectors3 points) : points_(std::move(points)) {
-    cloud_.points = &points_;
-    if (points_.rows() > 0) {
-      tree_ = std::make_unique<KdTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-    }
-  }
-  PointIndex(const PointIndex&) = delete;
-  PointIndex& operator=(const PointIndex&) = delete;
-
-  std::size_t size() const { return std::size_t(points_.rows()); }
-  const Vectors3& points() const { return points_; }
-
-  // The points within `radius` of q, nearest first.
-  void within(const Eigen::Vector3d& q, double radius, Hits& out) const {
-    out.clear();
-    if (!tree_) return;
-    tree_->radiusSearch(q.data(), radius * radius, out, nanoflann::SearchParams(32, 0, true));
-  }
-  // The k nearest points of q, nearest first.
-  void nearest(const Eigen::Vector3d& q, std::size_t k, Hits& out) const {
-    out.clear();
-    if (!tree_) return;
-    k = std::min(k, size());
-    std::vector<std::uint32_t> index(k);
-    std::vector<double> d2(k);
-    k = tree_->knnSearch(q.data(), k, index.data(), d2.data());
-    for (std::size_t i = 0; i < k; ++i)
-      out.emplace_back(index[i], d2[i]);
-  }
-
- private:
-  Vectors3 points_;
-  Cloud cloud_;
-  std::unique_ptr<KdTree> tree_;
-};
+using Hits = PointIndex::Hits;
 
 double median(std::vector<double> v) {
   if (v.empty()) return kNaN;

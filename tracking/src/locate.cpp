@@ -7,8 +7,10 @@
 #include <unordered_map>
 
 #include "granmem/core/error.hpp"
+#include "granmem/rotation/hole_contacts.hpp"
 #include "granmem/tracking/candidates.hpp"
 #include "granmem/tracking/grain_fit.hpp"
+#include "granmem/tracking/hole_axis.hpp"
 #include "granmem/tracking/illumination.hpp"
 
 namespace granmem {
@@ -307,28 +309,41 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
 
   sum.candidates = grains.size();
   Detections d;
-  d.has_axis = hole > 0 && o.fit_axis;
+  d.has_axis = hole > 0;
   d.source = stack.source;
   d.length_unit = stack.voxel_size ? stack.unit : "voxel";
   d.voxel_size = stack.voxel_size;
+  std::vector<double> contact_radius;
+  constexpr double kDegree = 3.14159265358979323846 / 180;
   for (const Candidate& g : grains) {
     if (!g.active) continue;
     const GrainFit& f = g.fit;
     const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs);
     // The fitted radius runs small (the blur's curvature shift, ~0.2 voxel at 12 voxels):
     // with it, grains cut by a fraction of a voxel were not flagged. Not below the nominal.
-    const Eigen::Vector3d r_voxels =
-        Eigen::Vector3d::Constant(std::max(f.sphere.radius, radius)).cwiseQuotient(vs);
+    const double outer = std::max(f.sphere.radius, radius);
+    const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(outer).cwiseQuotient(vs);
     const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
                       ((voxel + r_voxels).array() > dims.array() - 0.5).any();
     sum.on_edge += edge;
+    contact_radius.push_back(outer);
     // Physical units when the voxel size is known, voxels otherwise (vs = 1 then).
     d.add(f.sphere.centre, f.sphere.radius, quality(f), edge);
-    if (d.has_axis) {
-      const auto row = Eigen::Index(d.size() - 1);
-      d.axis.row(row) = f.sphere.axis.transpose();
-      d.axis_quality[d.size() - 1] = quality(f);
+    if (!d.has_axis || edge) continue;  // a cut grain's hole may be cut too: no axis
+    const std::size_t row = d.size() - 1;
+    if (o.fit_axis) {
+      // Seen when the fit pins it down: its standard error under the limit.
+      if (!(f.axis_sigma <= o.max_axis_sigma_degrees * kDegree)) continue;
+      d.axis.row(Eigen::Index(row)) = f.sphere.axis.transpose();
+      d.axis_quality[row] = 1 / (1 + f.axis_sigma / kDegree);
+    } else {
+      d.axis.row(Eigen::Index(row)) = lab_hole_axis(stack, f.sphere.centre, radius, vs).transpose();
     }
+  }
+  if (d.has_axis) {
+    HoleContactOptions contacts;
+    contacts.hole_fraction = hole;
+    d.hole_contact = hole_contacts(d.position, contact_radius, d.axis, contacts);
   }
   sum.rejected = sum.candidates - d.size();
   sum.located = d.size();

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <vector>
 
 #include "granmem/tracking/holed_sphere.hpp"
@@ -27,6 +28,9 @@ struct GrainFit {
   double rms = 0;               // residual root mean square
   int iterations = 0;
   bool converged = false;
+  // The fitted axis' standard error, radians (from the cost's curvature); NaN when the axis
+  // was not fitted or the fit did not converge.
+  double axis_sigma = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct GrainFitOptions {

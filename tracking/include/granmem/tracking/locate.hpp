@@ -12,8 +12,12 @@ struct LocateOptions {
   bool dark_grains = true;     // bright fluid, dark grains with bright holes
   double hole_fraction = 0.3;  // hole diameter over grain diameter; 0: no hole
   bool correct_illumination = true;
-  int beam_axis = 0;              // the laser's path: 0 along x, 1 along y
-  bool fit_axis = true;           // fit the hole's axis too (with a hole)
+  int beam_axis = 0;  // the laser's path: 0 along x, 1 along y
+  // The hole's axis: fitted with the model (with a hole), or, without, the lab's classical
+  // estimate (hole_axis.hpp). A fitted axis whose standard error exceeds the limit is not
+  // seen (NaN): the hole is blocked or too dim. Its axis_quality is 1 / (1 + error/deg).
+  bool fit_axis = true;
+  double max_axis_sigma_degrees = 10;
   double min_contrast = 0.4;      // fitted fluid - grain level, normalised; below: rejected
   double radius_tolerance = 0.3;  // fitted radius within (1 +- this) x the nominal
   // Model fits of every grain; from the second on, the neighbours are in the model. Each

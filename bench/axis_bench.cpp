@@ -1,0 +1,132 @@
+// Hole axes on rendered dense packings: how many interior grains get an axis, the fitted
+// axis' angular error side by side with the lab's classical estimate (the largest-
+// eigenvalue axis of the bright hole voxels within 0.8 R, hole_axis.hpp) on the same
+// centres, how well the fit's standard error predicts its error, and the hole-contact
+// flag's precision and recall against the contacts of the true packing.
+//
+//   axis_bench [--grains N] [--phi F] [--diameters 8,12,16] [--z-ratios 1,1.5] [--bits 8]
+//              [--threads T] [--seed S] [--out axis_bench.csv]
+//
+// Figures and how they were measured: docs/BENCHMARKS.md, "Hole axes".
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <string>
+
+#include "bench_options.hpp"
+#include "granmem/rotation/hole_contacts.hpp"
+#include "granmem/rotation/single_axis_rotation.hpp"
+#include "granmem/tracking/hole_axis.hpp"
+#include "granmem/tracking/locate.hpp"
+#include "locate_score.hpp"
+
+namespace {
+
+using namespace granmem;
+using namespace granmem::testing;
+
+constexpr double kDegree = 3.14159265358979323846 / 180;
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(q * double(v.size())));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+  return v[k];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bench::ScanBenchOptions o;
+  o.out = "axis_bench.csv";
+  o.bits = {8};
+  const bool parsed = bench::parse_options(argc, argv, "axis_bench", o.setters());
+  if (!parsed) return 2;
+  omp_set_num_threads(o.threads);
+  std::ofstream csv(o.out);
+  csv << "diameter,z_ratio,bits,interior_found,with_axis,fit_median_deg,fit_p95_deg,"
+         "lab_with_axis,lab_median_deg,lab_p95_deg,sigma_median_deg,within_2sigma,"
+         "true_contacts,flagged,flag_precision,flag_recall,clear_median_deg,clear_p95_deg\n";
+  std::cout << "phi " << o.phi << ", " << o.threads << " threads, seed " << o.seed
+            << "; angles in degrees, interior grains found\n"
+            << " d  z  bit  found  axis%   fit med  p95    lab axis%  med   p95    sigma med "
+               "<2sigma%  contacts flagged prec  recall  unflagged med p95\n";
+  for (double dz : o.z_ratios) {
+    for (double diameter : o.diameters) {
+      PackingScan scan = packing_scan(o.grains, o.phi, diameter, dz, o.seed);
+      const Eigen::Vector3d vs = *scan.options.voxel_size;
+      for (double b : o.bits) {
+        scan.options.bits = int(b);
+        Table truth;
+        Stack stack = render_scan(scan.grains, scan.options, &truth);
+        LocateOptions lo;
+        lo.diameter = diameter;
+        lo.hole_fraction = scan.options.hole_fraction;
+        const Detections d = locate(stack, lo);  // leaves `stack` normalised
+        const LocateMatch m = match_locate(d, truth, vs);
+
+        const std::size_t n = truth.rows();
+        const std::vector<std::uint8_t> true_contact =
+            true_hole_contacts(truth, m, vs, scan.options.hole_fraction);
+        std::vector<double> fit_error, lab_error, sigma, clear_error;
+        std::size_t found = 0, lab_found = 0, within = 0, contacts = 0, flagged = 0, hits = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          if (m.edge[i] || m.of_grain[i] < 0) continue;
+          const auto k = Eigen::Index(m.of_grain[i]);
+          ++found;
+          const Eigen::Vector3d t(truth["ax"].values[i], truth["ay"].values[i],
+                                  truth["az"].values[i]);
+          const Eigen::Vector3d a = d.axis.row(k).transpose();
+          const Eigen::Vector3d centre = d.position.row(k).transpose();
+          contacts += true_contact[i];
+          flagged += d.hole_contact[std::size_t(k)];
+          hits += true_contact[i] && d.hole_contact[std::size_t(k)];
+          if (a.allFinite()) {
+            const double e = single_axis_angle(a, t) / kDegree;
+            fit_error.push_back(e);
+            const double s = 1 / d.axis_quality[std::size_t(k)] - 1;
+            sigma.push_back(s);
+            within += e <= 2 * s;
+            if (!d.hole_contact[std::size_t(k)]) clear_error.push_back(e);
+          }
+          const Eigen::Vector3d lab = lab_hole_axis(stack, centre, 0.5, vs);
+          if (lab.allFinite()) {
+            ++lab_found;
+            lab_error.push_back(single_axis_angle(lab, t) / kDegree);
+          }
+        }
+        const double axis_pct =
+            100.0 * double(fit_error.size()) / double(std::max<std::size_t>(found, 1));
+        const double lab_pct = 100.0 * double(lab_found) / double(std::max<std::size_t>(found, 1));
+        const double precision = flagged ? double(hits) / double(flagged) : NAN;
+        const double recall = contacts ? double(hits) / double(contacts) : NAN;
+        const double within_pct =
+            100.0 * double(within) / double(std::max<std::size_t>(fit_error.size(), 1));
+        std::cout << std::fixed << std::setw(2) << int(diameter) << std::setprecision(1)
+                  << std::setw(4) << dz << std::setw(4) << int(b) << std::setw(7) << found
+                  << std::setprecision(2) << std::setw(8) << axis_pct << std::setw(9)
+                  << percentile(fit_error, 0.5) << std::setw(6) << percentile(fit_error, 0.95)
+                  << std::setw(10) << lab_pct << std::setw(7) << percentile(lab_error, 0.5)
+                  << std::setw(7) << percentile(lab_error, 0.95) << std::setw(10)
+                  << percentile(sigma, 0.5) << std::setw(8) << within_pct << std::setw(10)
+                  << contacts << std::setw(8) << flagged << std::setw(6) << precision
+                  << std::setw(7) << recall << std::setw(10) << percentile(clear_error, 0.5)
+                  << std::setw(6) << percentile(clear_error, 0.95) << "\n"
+                  << std::defaultfloat;
+        csv << diameter << "," << dz << "," << b << "," << found << "," << fit_error.size() << ","
+            << percentile(fit_error, 0.5) << "," << percentile(fit_error, 0.95) << "," << lab_found
+            << "," << percentile(lab_error, 0.5) << "," << percentile(lab_error, 0.95) << ","
+            << percentile(sigma, 0.5) << "," << within_pct / 100 << "," << contacts << ","
+            << flagged << "," << precision << "," << recall << "," << percentile(clear_error, 0.5)
+            << "," << percentile(clear_error, 0.95) << "\n";
+        csv.flush();
+      }
+    }
+  }
+  return 0;
+}

@@ -65,7 +65,11 @@ FrameMotion grain_motion(const RunHeader& header, const Frame& before, const Fra
     m.theta_axis.assign(n, nan);
     m.rot_disp.assign(n, nan);
   }
-  if (header.has_orientation) m.theta_full.assign(n, nan);
+  if (header.has_orientation) {
+    m.theta_full.assign(n, nan);
+    m.theta_body_x.assign(n, nan);
+    m.theta_body_y.assign(n, nan);
+  }
 
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t i = m.grain[k];
@@ -76,8 +80,13 @@ FrameMotion grain_motion(const RunHeader& header, const Frame& before, const Fra
     m.theta_axis[k] = single_axis_angle(axis_of(header, before, i), axis_of(header, after, i));
     m.rot_disp[k] = m.theta_axis[k] * header.radius[i];
     if (header.has_orientation) {
-      m.theta_full[k] =
-          full_rotation_angle(quaternion(before.orientation, i), quaternion(after.orientation, i));
+      const Eigen::Quaterniond q0 = quaternion(before.orientation, i);
+      const Eigen::Quaterniond q1 = quaternion(after.orientation, i);
+      m.theta_full[k] = full_rotation_angle(q0, q1);
+      m.theta_body_x[k] =
+          single_axis_angle(q0 * Eigen::Vector3d::UnitX(), q1 * Eigen::Vector3d::UnitX());
+      m.theta_body_y[k] =
+          single_axis_angle(q0 * Eigen::Vector3d::UnitY(), q1 * Eigen::Vector3d::UnitY());
     }
   }
   return m;

@@ -46,6 +46,8 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   Column& theta_axis = d.add("theta_axis_deg", "deg");
   Column& rot_disp = d.add("rot_disp", L);
   Column* theta_full = full ? &d.add("theta_full_deg", "deg") : nullptr;
+  Column* theta_body_x = full ? &d.add("theta_body_x_deg", "deg") : nullptr;
+  Column* theta_body_y = full ? &d.add("theta_body_y_deg", "deg") : nullptr;
 
   Table& p = a.per_frame;
   Column& p_frame = p.add("frame", "", true);
@@ -85,7 +87,11 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     append(theta_axis.values, theta_deg);
     append(rot_disp.values, rot_len);
     const std::vector<double> full_deg = in_degrees(m.theta_full);  // empty without orientations
-    if (full) append(theta_full->values, full_deg);
+    if (full) {
+      append(theta_full->values, full_deg);
+      append(theta_body_x->values, in_degrees(m.theta_body_x));
+      append(theta_body_y->values, in_degrees(m.theta_body_y));
+    }
 
     const Summary s_dr = summarize(m.dr), s_theta = summarize(theta_deg),
                   s_rot = summarize(rot_len);
@@ -122,7 +128,9 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   if (quantities.empty()) {
     quantities.push_back("dr");
     if (rot) quantities.insert(quantities.end(), {"theta_axis_deg", "rot_disp"});
-    if (full) quantities.push_back("theta_full_deg");
+    if (full)
+      quantities.insert(quantities.end(),
+                        {"theta_full_deg", "theta_body_x_deg", "theta_body_y_deg"});
   }
   std::vector<std::size_t> window;
   for (std::size_t r = 0; r < d.rows(); ++r) {

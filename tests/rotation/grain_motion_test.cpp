@@ -353,6 +353,43 @@ TEST(GrainMotion, OrientationsGiveBothRotationsWhenTheRunHasNoAxes) {
   EXPECT_NEAR(m.rot_disp[3], 0.2 * 4.0, 1e-13);
 }
 
+TEST(GrainMotion, OrientationsGiveEachBodyAxisItsSingleAxisRotation) {
+  // A turn by phi about one body axis leaves that axis where it was and tilts the other
+  // two by phi; a turn about a body diagonal (1, 1, 1)/sqrt 3 tilts each axis e by
+  // arccos(cos phi + (1 - cos phi)/3) (Rodrigues: e . R e = cos phi + (1 - cos phi)(u.e)^2).
+  RunHeader h = header_of(3, /*axes=*/false, /*orientations=*/true);
+  Frame before = frame_of(h), after = frame_of(h);
+  const double phi = 0.4;
+  const Eigen::Quaterniond start(
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.5).normalized()));
+  for (std::size_t i = 0; i < 3; ++i)
+    set_orientation(before, i, start);
+  // Body axes in the lab: start * e.
+  set_orientation(
+      after, 0,
+      Eigen::Quaterniond(Eigen::AngleAxisd(phi, start * Eigen::Vector3d::UnitX())) * start);
+  set_orientation(
+      after, 1,
+      Eigen::Quaterniond(Eigen::AngleAxisd(phi, start * Eigen::Vector3d::UnitZ())) * start);
+  const Eigen::Vector3d diagonal = Eigen::Vector3d::Ones().normalized();
+  set_orientation(after, 2, Eigen::Quaterniond(Eigen::AngleAxisd(phi, start * diagonal)) * start);
+
+  const FrameMotion m = grain_motion(h, before, after, {});
+  ASSERT_EQ(m.theta_body_x.size(), 3u);
+  ASSERT_EQ(m.theta_body_y.size(), 3u);
+  EXPECT_NEAR(m.theta_body_x[0], 0, 1e-12);  // about x
+  EXPECT_NEAR(m.theta_body_y[0], phi, 1e-12);
+  EXPECT_NEAR(m.theta_axis[0], phi, 1e-12);
+  EXPECT_NEAR(m.theta_body_x[1], phi, 1e-12);  // about the cavity axis z
+  EXPECT_NEAR(m.theta_body_y[1], phi, 1e-12);
+  EXPECT_NEAR(m.theta_axis[1], 0, 1e-12);
+  const double tilt = std::acos(std::cos(phi) + (1 - std::cos(phi)) / 3);
+  EXPECT_NEAR(m.theta_body_x[2], tilt, 1e-12);
+  EXPECT_NEAR(m.theta_body_y[2], tilt, 1e-12);
+  EXPECT_NEAR(m.theta_axis[2], tilt, 1e-12);
+  EXPECT_NEAR(m.theta_full[2], phi, 1e-12);
+}
+
 TEST(GrainMotion, TrackedAxesTakePrecedenceOverOrientations) {
   // Experiments with both: the tracked axis is the measurement of the single-axis
   // rotation; the orientation only gives the full rotation.

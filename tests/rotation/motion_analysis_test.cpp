@@ -131,7 +131,8 @@ TEST_F(MotionAnalysisTest, DisplacementsTableHasOneRowPerGrainSeenInConsecutiveF
   const Table& d = a.displacements;
   ASSERT_EQ(column_names(d),
             (std::vector<std::string>{"frame", "particle", "dx", "dy", "dz", "dr", "theta_axis_deg",
-                                      "rot_disp", "theta_full_deg"}));
+                                      "rot_disp", "theta_full_deg", "theta_body_x_deg",
+                                      "theta_body_y_deg"}));
   EXPECT_EQ(d["dx"].unit, "mm");
   EXPECT_EQ(d["rot_disp"].unit, "mm");
   EXPECT_EQ(d["theta_axis_deg"].unit, "deg");
@@ -234,8 +235,8 @@ TEST_F(MotionAnalysisTest, DefaultPdfsPoolEveryFrameAndIntegrateToOne) {
     EXPECT_EQ(pdf_total_count(pdf), 5.0) << q;  // all five displacements
     EXPECT_NEAR(pdf_integral(pdf), 1.0, 1e-12) << q;
   }
-  EXPECT_EQ(quantities,
-            (std::set<std::string>{"dr", "theta_axis_deg", "rot_disp", "theta_full_deg"}));
+  EXPECT_EQ(quantities, (std::set<std::string>{"dr", "theta_axis_deg", "rot_disp", "theta_full_deg",
+                                               "theta_body_x_deg", "theta_body_y_deg"}));
   // The default range is that of the values: dr from 2 to 5.
   EXPECT_EQ(a.pdfs.at("dr")["bin_lo"].values.front(), 2.0);
   EXPECT_EQ(a.pdfs.at("dr")["bin_hi"].values.back(), 5.0);
@@ -403,9 +404,15 @@ TEST_F(MotionAnalysisTest, WrittenTablesReadBackExactly) {
     EXPECT_EQ(p.parent_path(), out);
     names.insert(p.filename().string());
   }
-  const std::set<std::string> expected_names{
-      "displacements.csv", "per_frame.csv",          "pdf_dr.csv", "pdf_theta_axis_deg.csv",
-      "pdf_rot_disp.csv",  "pdf_theta_full_deg.csv", "analysis.h5"};
+  const std::set<std::string> expected_names{"displacements.csv",
+                                             "per_frame.csv",
+                                             "pdf_dr.csv",
+                                             "pdf_theta_axis_deg.csv",
+                                             "pdf_rot_disp.csv",
+                                             "pdf_theta_full_deg.csv",
+                                             "pdf_theta_body_x_deg.csv",
+                                             "pdf_theta_body_y_deg.csv",
+                                             "analysis.h5"};
   EXPECT_EQ(names, expected_names);
   // Nothing else is left in the folder: no temporary files.
   std::set<std::string> present;
@@ -468,7 +475,7 @@ TEST_F(MotionAnalysisTest, DefaultPdfWithoutMeasuredValuesIsSkippedWithANote) {
   const MotionAnalysis a = analyze_motion(stored(run), {});
   EXPECT_EQ(a.pdfs.size(), 1u);  // dr only
   EXPECT_EQ(a.pdfs.count("dr"), 1u);
-  ASSERT_EQ(a.notes.size(), 3u);  // theta_axis_deg, rot_disp, theta_full_deg
+  ASSERT_EQ(a.notes.size(), 5u);  // theta_axis_deg, rot_disp, theta_full_deg, theta_body_x/y
   EXPECT_NE(a.notes[0].find("no pdf of theta_axis_deg"), std::string::npos);
   // Asked for by name, the same pdf is an error.
   AnalysisOptions asked;

@@ -34,6 +34,9 @@ struct FrameMotion {
   std::vector<double> theta_axis;  // single-axis rotation, rad; NaN where not measured
   std::vector<double> rot_disp;    // theta_axis * radius, length
   std::vector<double> theta_full;  // full rotation, rad; empty without orientations
+  // With orientations: the single-axis rotation of the body's other principal axes (x and
+  // y; the cavity is z), rad, for the paper's comparison of one-axis and full rotations.
+  std::vector<double> theta_body_x, theta_body_y;
   Eigen::Vector3d drift = Eigen::Vector3d::Zero();  // mean displacement before removal
   bool has_rotation = false;                        // the run has axes or orientations
 };

@@ -98,8 +98,8 @@ TEST(Locate, DensePackingIsotropicVoxels) {
   // Hole axes: the angle between the fitted and the true line.
   ASSERT_TRUE(d.has_axis);
   EXPECT_EQ(s.axis_degrees.size(), s.interior_found);
-  EXPECT_LT(s.axis_percentile(0.5), 2.0);
-  EXPECT_LT(s.axis_percentile(0.9), 5.0);
+  EXPECT_LT(s.axis_percentile(0.5), 0.7);  // 0.48 measured (0.88 before the axis refit)
+  EXPECT_LT(s.axis_percentile(0.9), 1.5);
 }
 
 TEST(Locate, DensePackingCoarserSlices) {
@@ -124,7 +124,11 @@ TEST(Locate, DensePackingCoarserSlices) {
   report("d = 12, slices 1.5x coarser (errors in slices along z)", s);
   expect_accurate(s);
   expect_edge_flags(d, truth, rendered, vs, 0.25);
-  EXPECT_LT(s.axis_percentile(0.5), 4.0);
+  // Issue 5's bar, median <= 1 deg: the blur along z, 2.1x that across here, tilts a
+  // model blurred alike everywhere by ~2.3 deg (median); the axis refit on the inner
+  // voxels with a blur of its own along z does not tilt (hole_axis.hpp).
+  EXPECT_LT(s.axis_percentile(0.5), 1.0);
+  EXPECT_LT(s.axis_percentile(0.9), 2.5);
 }
 
 TEST(Locate, SmallGrains) {

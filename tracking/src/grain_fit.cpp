@@ -1,10 +1,9 @@
 #include "granmem/tracking/grain_fit.hpp"
 
 #include <ceres/tiny_solver.h>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <cmath>
+
+#include "fit_covariance.hpp"
 
 namespace granmem {
 namespace {
@@ -112,28 +111,8 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
       x.allFinite();
   fit.rms = std::sqrt(2 * summary.final_cost / std::max<double>(1, double(window.points.size())));
   if constexpr (GrainResiduals<kParameters>::kAxis) {
-    // The axis' standard error from the curvature of the cost at the minimum (Gauss-Newton:
-    // covariance sigma^2 (J^T J)^-1, sigma^2 the residual variance): the larger semi-axis
-    // of the two tangent coordinates' error ellipse, over |axis0 + t| (their lever arm).
-    const int n = f.NumResiduals();
-    if (fit.converged && n > kParameters) {
-      Eigen::VectorXd r(n);
-      Eigen::Matrix<double, Eigen::Dynamic, kParameters> J(n, kParameters);
-      f(x.data(), r.data(), J.data());
-      const Eigen::Matrix<double, kParameters, kParameters> jtj = J.transpose() * J;
-      const Eigen::LDLT<Eigen::Matrix<double, kParameters, kParameters>> ldlt(jtj);
-      if (ldlt.info() == Eigen::Success && ldlt.isPositive()) {
-        const double variance = 2 * summary.final_cost / double(n - kParameters);
-        const Eigen::Matrix<double, kParameters, kParameters> covariance =
-            variance * ldlt.solve(Eigen::Matrix<double, kParameters, kParameters>::Identity());
-        const Eigen::Matrix2d tangent = covariance.template bottomRightCorner<2, 2>();
-        const double lever = (f.axis0 + x[7] * f.e1 + x[8] * f.e2).norm();
-        fit.axis_sigma =
-            std::sqrt(std::max(
-                0.0,
-                Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(tangent).eigenvalues().maxCoeff())) /
-            lever;
-      }
+    if (fit.converged) {
+      fit.axis_sigma = axis_standard_error(f, x, 7, (f.axis0 + x[7] * f.e1 + x[8] * f.e2).norm());
     }
   }
   return fit;

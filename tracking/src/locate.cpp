@@ -305,6 +305,39 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
     fit_pass(true, [&](std::size_t i) { return refit_all || near_new(i); });
     select();
   }
+  // The hole's axis, refitted on each grain's inner voxels with a blur of its own along z
+  // (hole_axis.hpp): the model fits' axes tilt on scans of coarser slices.
+  if (hole > 0 && o.fit_axis) {
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<std::size_t> ids;
+    for (std::size_t i = 0; i < grains.size(); ++i) {
+      if (grains[i].active) {
+        centres.push_back(grains[i].start.centre);
+        ids.push_back(i);
+      }
+    }
+    const GrainGrid grid(centres, diameter);
+    const HoleAxisOptions axis_options;
+#pragma omp parallel
+    {
+      GrainWindow window;
+      std::vector<const HoledSphere*> near;
+#pragma omp for schedule(dynamic, 16)
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        GrainFit& f = grains[ids[k]].fit;
+        near.clear();
+        grid.near(f.sphere.centre, 1, [&](std::size_t j) {
+          if (j != k) near.push_back(&grains[ids[j]].start);
+        });
+        window_of(stack, f.sphere, axis_options.within * f.sphere.radius, near, true, vs, window);
+        const HoleAxisFit refined = fit_hole_axis(window, f, axis_options);
+        if (refined.converged && std::isfinite(refined.sigma)) {
+          f.sphere.axis = refined.axis;
+          f.axis_sigma = refined.sigma;
+        }
+      }
+    }
+  }
   sum.seconds_fits = lap();
 
   sum.candidates = grains.size();

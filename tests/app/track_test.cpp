@@ -9,8 +9,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <map>
 
 #include "granmem/core/trajectory_store.hpp"
+#include "granmem/rotation/single_axis_rotation.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "run_granmem.hpp"
 
@@ -24,16 +27,18 @@ const Eigen::Vector3d kVoxel(5e-3 / 12, 5e-3 / 12, 1.5 * 5e-3 / 12);
 struct Truth {
   std::vector<double> id;
   std::vector<Eigen::Vector3d> voxel;  // positions in voxels
+  std::vector<Eigen::Vector3d> axis;   // hole axes
 };
 
 Truth read_truth(int scan) {
-  const Table t =
-      read_csv(kScans / ("truth" + std::to_string(scan) + ".csv"), {"particle", "x", "y", "z"})
-          .table;
+  const Table t = read_csv(kScans / ("truth" + std::to_string(scan) + ".csv"),
+                           {"particle", "x", "y", "z", "ax", "ay", "az"})
+                      .table;
   Truth truth;
   for (std::size_t i = 0; i < t.rows(); ++i) {
     truth.id.push_back(t["particle"].values[i]);
     truth.voxel.emplace_back(t["x"].values[i], t["y"].values[i], t["z"].values[i]);
+    truth.axis.emplace_back(t["ax"].values[i], t["ay"].values[i], t["az"].values[i]);
   }
   return truth;
 }
@@ -157,6 +162,37 @@ TEST_F(TrackTest, TracksTheScansIntoTrajectoriesThatAnalyzeReads) {
   }
   granmem_ok({"analyze", "tracks.h5", "--out", "analysis"});
   EXPECT_TRUE(std::filesystem::exists(in_work("analysis/analysis.h5")));
+
+  // The single-axis rotations analyze measured against the true ones, grain by grain
+  // (issue 5's bar: median error <= 1 deg, 95 % <= 3 deg).
+  std::map<double, std::size_t> truth_of_track;  // track id -> true grain
+  for (std::size_t i = 0; i < truth[0].id.size(); ++i) {
+    if (matched[0][i] >= 0)
+      truth_of_track[double(store.header().id[std::size_t(matched[0][i])])] = i;
+  }
+  const Table d =
+      read_csv(in_work("analysis/displacements.csv"), {"frame", "particle", "theta_axis_deg"})
+          .table;
+  std::vector<double> error;
+  for (std::size_t r = 0; r < d.rows(); ++r) {
+    const double measured = d["theta_axis_deg"].values[r];
+    const auto it = truth_of_track.find(d["particle"].values[r]);
+    if (!std::isfinite(measured) || it == truth_of_track.end()) continue;
+    const auto scan = std::size_t(std::lround(d["frame"].values[r]));  // labels 0, 1, 2
+    ASSERT_GE(scan, 1u);
+    ASSERT_LE(scan, 2u);
+    const double truth_deg =
+        single_axis_angle(truth[scan - 1].axis[it->second], truth[scan].axis[it->second]) * 180 /
+        M_PI;
+    error.push_back(std::abs(measured - truth_deg));
+  }
+  ASSERT_GE(double(error.size()), 0.9 * 2 * double(truth[0].id.size()));
+  std::sort(error.begin(), error.end());
+  const double median = error[error.size() / 2], p95 = error[error.size() * 95 / 100];
+  std::cout << "single-axis rotation error: median " << median << " deg, 95 % " << p95
+            << " deg over " << error.size() << " grain-steps\n";
+  EXPECT_LT(median, 1.0);
+  EXPECT_LT(p95, 3.0);
 }
 
 TEST_F(TrackTest, BadScansStopWithOneLineAndWriteNothing) {

@@ -46,6 +46,26 @@ void print_per_frame(const Table& p, const std::string& unit) {
 
 }  // namespace
 
+void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& options,
+                        const std::string& out, const std::map<std::string, std::string>& used) {
+  const RunHeader& h = run.header();
+  const MotionAnalysis a = analyze_motion(run, options);
+  const auto written = write_motion_analysis(a, out, {"granmem analyze " + run.file_name()}, used);
+  for (const std::string& note : a.notes)
+    std::cerr << "granmem: note: " << note << "\n";
+  const bool radius_known =
+      std::any_of(h.radius.begin(), h.radius.end(), [](double r) { return std::isfinite(r); });
+  if ((h.has_axis || h.has_orientation) && !radius_known) {
+    std::cerr << "granmem: note: " << run.file_name()
+              << " has no grain radius, so rot_disp is nan (import with --radius)\n";
+  }
+  std::cout << run.file_name() << ": " << a.displacements.rows() << " displacements over "
+            << a.per_frame.rows() << " frame pairs, lengths in " << a.length_unit << "\n";
+  print_per_frame(a.per_frame, a.length_unit);
+  for (const auto& path : written)
+    std::cout << "wrote " << path.string() << "\n";
+}
+
 void add_analyze(CLI::App& app) {
   struct Args {
     std::string run, out, wall_distance = "0", box, hole_contacts = "keep", pdf, pdf_frames,
@@ -113,26 +133,10 @@ void add_analyze(CLI::App& app) {
     if (!args->pdf_range.empty())
       options.density.range = parse_range(args->pdf_range, "--pdf-range");
 
-    const MotionAnalysis a = analyze_motion(run, options);
     std::map<std::string, std::string> used;
     for (const auto& [key, value] : used_options(*cmd))
       used[key.substr(key.find('/') + 1)] = value;
-    const auto written =
-        write_motion_analysis(a, args->out, {"granmem analyze " + args->run}, used);
-
-    for (const std::string& note : a.notes)
-      std::cerr << "granmem: note: " << note << "\n";
-    const bool radius_known =
-        std::any_of(h.radius.begin(), h.radius.end(), [](double r) { return std::isfinite(r); });
-    if ((h.has_axis || h.has_orientation) && !radius_known) {
-      std::cerr << "granmem: note: " << args->run
-                << " has no grain radius, so rot_disp is nan (import with --radius)\n";
-    }
-    std::cout << args->run << ": " << a.displacements.rows() << " displacements over "
-              << a.per_frame.rows() << " frame pairs, lengths in " << a.length_unit << "\n";
-    print_per_frame(a.per_frame, a.length_unit);
-    for (const auto& path : written)
-      std::cout << "wrote " << path.string() << "\n";
+    analyze_and_report(run, options, args->out, used);
   });
 }
 

@@ -4,6 +4,9 @@
 #include <map>
 #include <string>
 
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/rotation/motion_analysis.hpp"
+
 // The `granmem` subcommands. Each registers its options on `app`; its callback maps them
 // onto a library options struct, calls the library and prints the summary.
 namespace granmem::app {
@@ -17,6 +20,11 @@ void add_locate(CLI::App& app);
 void add_track(CLI::App& app);
 void add_render(CLI::App& app);
 void add_link(CLI::App& app);
+
+// `granmem analyze`'s work once its options are read: analyses `run`, writes the tables to
+// `out` with `used` as their parameters, prints the notes and the per-frame summary.
+void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& options,
+                        const std::string& out, const std::map<std::string, std::string>& used);
 
 // The options of a subcommand as actually used (given or default), "<command>/<option>"
 // -> value, for the output's /parameters.

@@ -164,7 +164,7 @@ void add_locate(CLI::App& app) {
 void add_track(CLI::App& app) {
   struct Args {
     std::vector<std::string> scans;
-    std::string out, detections;
+    std::string out, detections, analyze;
     LocateArgs locate;
     LinkArgs link;
   };
@@ -178,6 +178,9 @@ void add_track(CLI::App& app) {
   cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
   cmd->add_option("--detections", args->detections,
                   "folder to keep each scan's detections in (scan name + .h5)");
+  cmd->add_option("--analyze", args->analyze,
+                  "then analyze the trajectories into this folder (as granmem analyze, "
+                  "grains touching through their hole left out of the rotations)");
   add_locate_options(cmd, args->locate);
   add_link_options(cmd, args->link);
   cmd->callback([args, cmd] {
@@ -194,6 +197,12 @@ void add_track(CLI::App& app) {
       }
     }
     link_and_write(std::move(found), scans, args->link, args->out, *cmd);
+    if (!args->analyze.empty()) {
+      AnalysisOptions options;
+      options.motion.hole_contacts = HoleContactPolicy::exclude_rotations;  // the paper's choice
+      analyze_and_report(TrajectoryReader(args->out), options, args->analyze,
+                         {{"hole-contacts", "exclude-rotations"}});
+    }
   });
 }
 

@@ -124,9 +124,10 @@ TEST_F(TrackTest, RegionKeepsTheWholeStacksCoordinates) {
 }
 
 TEST_F(TrackTest, TracksTheScansIntoTrajectoriesThatAnalyzeReads) {
-  const RunResult r = granmem_ok({"track", (kScans / "scan2.tif").string(),
-                                  (kScans / "scan0.tif").string(), (kScans / "scan1.tif").string(),
-                                  "-d", "12", "--out", "tracks.h5", "--detections", "det"});
+  const RunResult r =
+      granmem_ok({"track", (kScans / "scan2.tif").string(), (kScans / "scan0.tif").string(),
+                  (kScans / "scan1.tif").string(), "-d", "12", "--out", "tracks.h5", "--detections",
+                  "det", "--analyze", "analysis"});
   // Scans are taken in natural order whatever the order given.
   EXPECT_LT(r.out.find("scan0.tif"), r.out.find("scan1.tif")) << r.out;
   EXPECT_LT(r.out.find("scan1.tif"), r.out.find("scan2.tif")) << r.out;
@@ -160,11 +161,13 @@ TEST_F(TrackTest, TracksTheScansIntoTrajectoriesThatAnalyzeReads) {
     }
     EXPECT_EQ(same, both) << "scan " << s;
   }
-  granmem_ok({"analyze", "tracks.h5", "--out", "analysis"});
+  // One command from scans to rotation statistics: the analysis, grains touching a
+  // neighbour through their hole left out of the rotations (their hole locks on it).
   EXPECT_TRUE(std::filesystem::exists(in_work("analysis/analysis.h5")));
+  EXPECT_NE(r.out.find("displacements.csv"), std::string::npos) << r.out;
 
-  // The single-axis rotations analyze measured against the true ones, grain by grain
-  // (issue 5's bar: median error <= 1 deg, 95 % <= 3 deg).
+  // The single-axis rotations measured against the true ones, grain by grain (issue 5's
+  // bar: median error <= 1 deg, 95 % <= 3 deg).
   std::map<double, std::size_t> truth_of_track;  // track id -> true grain
   for (std::size_t i = 0; i < truth[0].id.size(); ++i) {
     if (matched[0][i] >= 0)
@@ -186,7 +189,8 @@ TEST_F(TrackTest, TracksTheScansIntoTrajectoriesThatAnalyzeReads) {
         M_PI;
     error.push_back(std::abs(measured - truth_deg));
   }
-  ASSERT_GE(double(error.size()), 0.9 * 2 * double(truth[0].id.size()));
+  // A grain flagged in either scan of a pair has no rotation: ~a quarter in each.
+  ASSERT_GE(double(error.size()), 0.4 * 2 * double(truth[0].id.size()));
   std::sort(error.begin(), error.end());
   const double median = error[error.size() / 2], p95 = error[error.size() * 95 / 100];
   std::cout << "single-axis rotation error: median " << median << " deg, 95 % " << p95

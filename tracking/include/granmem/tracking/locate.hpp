@@ -40,8 +40,11 @@ struct LocateSummary {
 // with the voxels nearer another candidate left out, then with the neighbours' fitted
 // spheres in the model, since in a dense packing neighbours touch and would otherwise pull
 // the fit. Centroids are biased there and lock on the voxel grid; the model fit is not.
-// `stack` is normalised in place (illumination.hpp). Positions, radii in the stack's
-// unit when it has a voxel size, else in voxels; anisotropic voxels handled throughout.
+// Grains the candidates missed are searched for in what the found ones leave unexplained.
+// Last, each hole's axis is refitted on the grain's inner voxels with a blur of its own
+// along z (hole_axis.hpp), and grains touching a neighbour through their hole are flagged
+// (hole_contacts.hpp). `stack` is normalised in place (illumination.hpp). Positions, radii in the
+// stack's unit when it has a voxel size, else in voxels; anisotropic voxels handled throughout.
 Detections locate(Stack& stack, const LocateOptions& options, LocateSummary* summary = nullptr);
 
 }  // namespace granmem

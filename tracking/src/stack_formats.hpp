@@ -39,5 +39,4 @@ Stack read_hdf5_stack(const std::filesystem::path& path, const StackReadOptions&
 enum class TiffFormat { automatic, classic, big };
 void write_tiff_stack(const Stack& stack, const std::filesystem::path& path, TiffFormat format);
 
-
 }  // namespace granmem::stack_io

@@ -33,11 +33,12 @@ struct HoleAxisFit {
 // radius held, with a blur of its own across the slices (x, y) and along z. Why: a
 // model blurred alike in every direction, fitted to a scan blurred more along z (coarse
 // slices), tilts the axis by degrees: the hole's mouths and the sphere's rim are seen
-// through different blurs in different directions. Inside ~0.8 R there are no mouths, and
-// with each surface blurred by the Gaussian's width along its normal, sqrt(s_xy^2 +
-// (s_z^2 - s_xy^2) n_z^2) (exact for a plane), the image is symmetric under reflection
-// through every plane holding the axis, so the fit has its minimum on the true axis. On
-// isotropic scans it halves the error too (no mouth misfit). Starts from `grain`'s axis.
+// through different blurs in different directions. Inside ~0.8 R there are no mouths; the
+// hole's cross-section is a disk blurred by the blur's covariance in the plane across the
+// axis (exact for a cylinder), the sphere's rim blurred by the Gaussian's width along its
+// normal (exact for a plane); the image is then symmetric under reflection through every
+// plane holding the axis, so the fit has its minimum on the true axis. On isotropic
+// scans it halves the error too (no mouth misfit). Starts from `grain`'s axis.
 HoleAxisFit fit_hole_axis(const GrainWindow& inner, const GrainFit& grain,
                           const HoleAxisOptions& options = {});
 

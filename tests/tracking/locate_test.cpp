@@ -131,18 +131,25 @@ TEST(Locate, DensePackingCoarserSlices) {
   EXPECT_LT(s.axis_percentile(0.9), 2.5);
 }
 
+// A rendered dense packing of n grains, `diameter` voxels across, slices `z_ratio`
+// voxels apart, located with default options and scored against its truth.
+LocateScore locate_packing(std::size_t n, double diameter, double z_ratio, std::uint32_t seed,
+                           const char* what) {
+  PackingScan scan = packing_scan(n, kPhi, diameter, z_ratio, seed);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  LocateOptions o;
+  o.diameter = diameter;
+  const LocateScore s = score_locate(locate(stack, o), truth, *scan.options.voxel_size);
+  report(what, s);
+  return s;
+}
+
 TEST(Locate, SmallGrains) {
   // 8 voxels across: the hole, 2.4 voxels wide, reads no brighter than ~0.6 of the fluid
   // under the blur; the fits must still start from its axis (they ran out of iterations
   // from a wrong one, and 1.5 % of the grains were lost).
-  PackingScan scan = packing_scan(500, kPhi, 8, 1, 13);
-  Table truth;
-  Stack stack = render_scan(scan.grains, scan.options, &truth);
-  LocateOptions o;
-  o.diameter = 8;
-  const Detections d = locate(stack, o);
-  const LocateScore s = score_locate(d, truth, *scan.options.voxel_size);
-  report("d = 8, isotropic", s);
+  const LocateScore s = locate_packing(500, 8, 1, 13, "d = 8, isotropic");
   EXPECT_GT(s.interior, 300u);
   EXPECT_GE(double(s.interior_found), 0.995 * double(s.interior));
   EXPECT_LE(s.spurious, 1u);
@@ -157,14 +164,7 @@ TEST(Locate, SmallGrainsCoarseSlices) {
   // are found in what the others leave unexplained before the passes with neighbours
   // modelled (a fit was pulled into an unexplained grain and lost), and fits are given
   // up to 40 iterations (98.4 % found before both on the bench's scans).
-  PackingScan scan = packing_scan(1000, kPhi, 8, 1.5, 13);
-  Table truth;
-  Stack stack = render_scan(scan.grains, scan.options, &truth);
-  LocateOptions o;
-  o.diameter = 8;
-  const Detections d = locate(stack, o);
-  const LocateScore s = score_locate(d, truth, *scan.options.voxel_size);
-  report("d = 8, 1.5x slices", s);
+  const LocateScore s = locate_packing(1000, 8, 1.5, 13, "d = 8, 1.5x slices");
   EXPECT_GT(s.interior, 700u);
   EXPECT_GE(double(s.interior_found), 0.99 * double(s.interior));
   EXPECT_LE(s.spurious, 3u);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "granmem/core/point_index.hpp"
 #include "granmem/tracking/illumination.hpp"
 
 namespace granmem {
@@ -190,29 +191,17 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
   for (auto& f : by_slice)
     peaks.insert(peaks.end(), f.begin(), f.end());
   if (found) {
-    // Cells one diameter wide, in voxels.
-    const auto cell_of = [&](const Eigen::Vector3d& x) -> Eigen::Vector3i {
-      return x.cwiseQuotient(o.diameter).array().floor().cast<int>();
-    };
-    std::unordered_map<std::int64_t, std::vector<Eigen::Vector3d>> near_found;
-    for (const HoledSphere& g : *found) {
-      const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
-      near_found[cell_key(cell_of(c))].push_back(c);
+    // Within half a diameter of a found grain, in units of the diameter along each axis.
+    Vectors3 scaled(Eigen::Index(found->size()), 3);
+    for (std::size_t k = 0; k < found->size(); ++k) {
+      scaled.row(Eigen::Index(k)) =
+          (*found)[k].centre.cwiseQuotient(voxel_size).cwiseQuotient(o.diameter).transpose();
     }
+    const PointIndex index(std::move(scaled));
+    PointIndex::Hits hits;
     const auto explained = [&](const Peak& p) {
-      const Eigen::Vector3i cell = cell_of(p.x);
-      for (int dz = -1; dz <= 1; ++dz) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const auto it = near_found.find(cell_key(cell + Eigen::Vector3i(dx, dy, dz)));
-            if (it == near_found.end()) continue;
-            for (const Eigen::Vector3d& c : it->second) {
-              if ((c - p.x).cwiseQuotient(o.diameter).norm() < 0.5) return true;
-            }
-          }
-        }
-      }
-      return false;
+      index.within(p.x.cwiseQuotient(o.diameter), 0.5, hits);
+      return !hits.empty();
     };
     peaks.erase(std::remove_if(peaks.begin(), peaks.end(), explained), peaks.end());
   }

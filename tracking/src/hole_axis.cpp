@@ -63,6 +63,20 @@ struct InnerHoleResiduals {
     const T across = exp(x[0]), along_z = exp(x[1]), b = x[2], g = x[3];
     const Eigen::Matrix<T, 3, 1> raw = axis0.cast<T>() + x[4] * e1.cast<T>() + x[5] * e2.cast<T>();
     const Eigen::Matrix<T, 3, 1> a = raw / sqrt(raw.squaredNorm());
+    // The hole's cross-section: a disk blurred by the blur's covariance in the plane
+    // across the axis, across^2 I + (along_z^2 - across^2) (1 - a_z^2) u u^T, u the
+    // plane's direction nearest z: the isotropic part by the disk's table, the excess
+    // along u (or across it, when the blur along z is the smaller) by Gauss-Hermite.
+    // The same for every voxel.
+    Eigen::Matrix<T, 3, 1> u = Eigen::Matrix<T, 3, 1>(T(0), T(0), T(1)) - a.z() * a;
+    u = u / sqrt(u.squaredNorm() + T(1e-18));
+    const Eigen::Matrix<T, 3, 1> w = a.cross(u);
+    const T v_u = across * across + (along_z * along_z - across * across) * (T(1) - a.z() * a.z());
+    const T v_w = across * across;
+    const bool wider_along_u = v_u > v_w;
+    const T iso = sqrt(wider_along_u ? v_w : v_u);
+    const T excess = sqrt((wider_along_u ? v_u - v_w : v_w - v_u) + T(1e-18));
+    const T hole_radius = T(grain.hole * grain.radius) / iso;
     const bool clear = !window->clear.empty();
     for (int k = 0; k < NumResiduals(); ++k) {
       const Eigen::Vector3d d = window->points[std::size_t(k)] - grain.centre;
@@ -71,27 +85,12 @@ struct InnerHoleResiduals {
           normal_cdf(T(grain.radius - r) / blur_along(across, along_z, T(r > 0 ? d.z() / r : 0.0)));
       const T t = d.cast<T>().dot(a);
       const Eigen::Matrix<T, 3, 1> q = d.cast<T>() - t * a;  // across the axis
-      // The hole's cross-section: a disk blurred by the blur's covariance in the plane
-      // across the axis, across^2 I + (along_z^2 - across^2) (1 - a_z^2) u u^T, u the
-      // plane's direction nearest z: the isotropic part by the disk's table, the excess
-      // along u (or across it, when the blur along z is the smaller) by Gauss-Hermite.
-      Eigen::Matrix<T, 3, 1> u = Eigen::Matrix<T, 3, 1>(T(0), T(0), T(1)) - a.z() * a;
-      const T u_norm = sqrt(u.squaredNorm() + T(1e-18));
-      u = u / u_norm;
-      const Eigen::Matrix<T, 3, 1> w = a.cross(u);
       const T q1 = q.dot(u), q2 = q.dot(w);
-      const T v_u =
-          across * across + (along_z * along_z - across * across) * (T(1) - a.z() * a.z());
-      const T v_w = across * across;
-      const bool wider_along_u = v_u > v_w;
-      const T iso = sqrt(wider_along_u ? v_w : v_u);
-      const T excess = sqrt((wider_along_u ? v_u - v_w : v_w - v_u) + T(1e-18));
-      const T radius = T(grain.hole * grain.radius) / iso;
       T hole = T(0);
       for (int g = 0; g < 7; ++g) {
         const T p1 = wider_along_u ? q1 + excess * kNode[g] : q1;
         const T p2 = wider_along_u ? q2 : q2 + excess * kNode[g];
-        hole += kWeight[g] * disk_fraction(sqrt(p1 * p1 + p2 * p2 + T(1e-24)) / iso, radius);
+        hole += kWeight[g] * disk_fraction(sqrt(p1 * p1 + p2 * p2 + T(1e-24)) / iso, hole_radius);
       }
       const T m = sphere * (T(1) - hole);
       const double keep = clear ? window->clear[std::size_t(k)] : 1.0;

@@ -189,16 +189,26 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
   // One fit of every active grain that `refit` selects: with the voxels nearer another
   // grain left out or, once the neighbours are known, with them in the model. Each reads
   // its neighbours as the last pass left them, so the order of the fits does not matter.
-  auto fit_pass = [&](bool model_neighbours, auto refit) {
+  // The active grains (only those fitted, with `fitted_only`) and a grid to find them by.
+  struct Neighbours {
+    std::vector<std::size_t> ids;
+    GrainGrid grid;
+  };
+  auto neighbours = [&](bool fitted_only) {
     std::vector<Eigen::Vector3d> centres;
     std::vector<std::size_t> ids;
     for (std::size_t i = 0; i < grains.size(); ++i) {
-      if (grains[i].active && (grains[i].fitted || !model_neighbours)) {
+      if (grains[i].active && (grains[i].fitted || !fitted_only)) {
         centres.push_back(grains[i].start.centre);
         ids.push_back(i);
       }
     }
-    const GrainGrid grid(centres, diameter);
+    return Neighbours{std::move(ids), GrainGrid(centres, diameter)};
+  };
+  auto fit_pass = [&](bool model_neighbours, auto refit) {
+    const Neighbours known = neighbours(model_neighbours);
+    const std::vector<std::size_t>& ids = known.ids;
+    const GrainGrid& grid = known.grid;
     std::vector<GrainFit> fits(grains.size());
 #pragma omp parallel
     {
@@ -308,15 +318,9 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
   // The hole's axis, refitted on each grain's inner voxels with a blur of its own along z
   // (hole_axis.hpp): the model fits' axes tilt on scans of coarser slices.
   if (hole > 0 && o.fit_axis) {
-    std::vector<Eigen::Vector3d> centres;
-    std::vector<std::size_t> ids;
-    for (std::size_t i = 0; i < grains.size(); ++i) {
-      if (grains[i].active) {
-        centres.push_back(grains[i].start.centre);
-        ids.push_back(i);
-      }
-    }
-    const GrainGrid grid(centres, diameter);
+    const Neighbours known = neighbours(true);
+    const std::vector<std::size_t>& ids = known.ids;
+    const GrainGrid& grid = known.grid;
     const HoleAxisOptions axis_options;
 #pragma omp parallel
     {

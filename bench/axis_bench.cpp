@@ -9,6 +9,9 @@
 //
 //   axis_bench [--grains N] [--phi F] [--diameters 8,12,16] [--z-ratios 1,1.5] [--bits 8]
 //              [--psf 0.7,0.7,1.0] [--threads T] [--seed S] [--out axis_bench.csv]
+//              [--dump grains.csv]   (per grain of the first scan: true and fitted axes...)
+//
+// Prints locate's time per grain (all grains, wall clock) on stderr.
 //
 // Figures and how they were measured: docs/BENCHMARKS.md, "Hole axes".
 #include <omp.h>
@@ -56,10 +59,18 @@ int main(int argc, char** argv) {
     const std::vector<double> p = bench::number_list(v);
     if (p.size() == 3) psf = Eigen::Vector3d(p[0], p[1], p[2]);
   };
+  std::string dump;  // per grain: truth, found, axes, errors
+  setters["--dump"] = [&](const std::string& v) { dump = v; };
   const bool parsed = bench::parse_options(argc, argv, "axis_bench", setters);
   if (!parsed) return 2;
   omp_set_num_threads(o.threads);
   std::ofstream csv(o.out);
+  std::ofstream grains_csv;
+  if (!dump.empty()) {
+    grains_csv.open(dump);
+    grains_csv << "diameter,z_ratio,id,tx,ty,tz,ax,ay,az,cx,cy,cz,fx,fy,fz,radius,error_deg,"
+                  "sigma_deg,contact,flagged,lab_deg\n";
+  }
   csv << "diameter,z_ratio,bits,interior_found,with_axis,fit_median_deg,fit_p95_deg,"
          "lab_with_axis,lab_median_deg,lab_p95_deg,sigma_median_deg,within_2sigma,"
          "true_contacts,flagged,flag_precision,flag_recall,clear_median_deg,clear_p95_deg,"
@@ -81,7 +92,11 @@ int main(int argc, char** argv) {
         LocateOptions lo;
         lo.diameter = diameter;
         lo.hole_fraction = scan.options.hole_fraction;
-        const Detections d = locate(stack, lo);  // leaves `stack` normalised
+        LocateSummary summary;
+        const Detections d = locate(stack, lo, &summary);  // leaves `stack` normalised
+        std::cerr << "locate " << 1000 * summary.seconds / double(d.size()) << " ms/grain ("
+                  << d.size() << " grains, fits " << 1000 * summary.seconds_fits / double(d.size())
+                  << ")\n";
         const LocateMatch m = match_locate(d, truth, vs);
 
         const std::size_t n = truth.rows();
@@ -113,6 +128,20 @@ int main(int argc, char** argv) {
           if (lab.allFinite()) {
             ++lab_found;
             lab_error.push_back(single_axis_angle(lab, t) / kDegree);
+          }
+          if (grains_csv.is_open()) {
+            const Eigen::Vector3d c(truth["x"].values[i], truth["y"].values[i],
+                                    truth["z"].values[i]);  // voxels
+            const Eigen::Vector3d found_voxel = centre.cwiseQuotient(vs);
+            grains_csv << diameter << "," << dz << "," << i << "," << t.x() << "," << t.y() << ","
+                       << t.z() << "," << a.x() << "," << a.y() << "," << a.z() << "," << c.x()
+                       << "," << c.y() << "," << c.z() << "," << found_voxel.x() << ","
+                       << found_voxel.y() << "," << found_voxel.z() << ","
+                       << d.radius[std::size_t(k)] / vs.x() << ","
+                       << (a.allFinite() ? single_axis_angle(a, t) / kDegree : NAN) << ","
+                       << 1 / d.axis_quality[std::size_t(k)] - 1 << "," << int(true_contact[i])
+                       << "," << int(d.hole_contact[std::size_t(k)]) << ","
+                       << (lab.allFinite() ? single_axis_angle(lab, t) / kDegree : NAN) << "\n";
           }
         }
         // The second scan: each grain turned, the packing shifted, new noise.

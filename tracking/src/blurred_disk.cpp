@@ -46,6 +46,9 @@ struct Table {
 DiskFraction blurred_disk(double x, double y) {
   x = std::abs(x);
   if (!(x < kMaxX + kMaxY) || !(y > 0)) return {0, 0, 0};  // far, no hole, or not a number
+  // Eight widths outside or inside the rim: Phi(-8) ~ 6e-16 from 0 or 1.
+  if (x - y > 8) return {0, 0, 0};
+  if (y - x > 8) return {1, 0, 0};
   if (y >= kMaxY) {
     // A wide disk: the step's profile and its curvature's first correction (half the
     // curvature times the Gaussian's spread along the edge), P ~ Phi(w) - phi(w) / (2 y).

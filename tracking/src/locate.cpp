@@ -126,6 +126,32 @@ void window_of(const Stack& stack, const HoledSphere& s, double reach,
   }
 }
 
+// The voxels within `reach` of `centre`, each with what the neighbours leave clear, 1 -
+// the sum of their grain fractions there (`others`; voxels they cover are left out).
+template <class Others>
+void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
+                  const Others& others, const Eigen::Vector3d& vs, GrainWindow& window) {
+  const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
+  const Eigen::Vector3d lo = ((centre.array() - reach) / vs.array()).ceil().max(0.0);
+  const Eigen::Vector3d hi = ((centre.array() + reach) / vs.array()).floor().min(last);
+  window.points.clear();
+  window.intensity.clear();
+  window.clear.clear();
+  for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
+    for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
+      for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
+        const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
+        if ((p - centre).norm() > reach) continue;
+        const double clear = 1 - others(p);
+        if (clear < 1e-3) continue;
+        window.points.push_back(p);
+        window.intensity.push_back(fluid_fraction(stack.at(x, y, z)));
+        window.clear.push_back(clear);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) {
@@ -315,30 +341,83 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
     fit_pass(true, [&](std::size_t i) { return refit_all || near_new(i); });
     select();
   }
-  // The hole's axis, refitted on each grain's inner voxels with a blur of its own along z
-  // (hole_axis.hpp): the model fits' axes tilt on scans of coarser slices.
+  // The hole's axis, refitted on each grain's inner voxels with a blur of its own across
+  // and along z (hole_axis.hpp): the model fits' axes tilt on scans of coarser slices. The
+  // neighbours' grain fractions are added to the model's (the blur is linear, the grains
+  // do not overlap). Seen through the model fits' one blur, with their radius that runs
+  // small there, they tilt the axes by a degree where the blur along z is wide; so first a
+  // sample of the grains is refitted with them so, for the scan's blur (the medians of the
+  // refits') and the model fits' radius shortfall (the median of refit - model fit
+  // radius), and then every grain with its neighbours seen through that blur, their radius
+  // so corrected.
   if (hole > 0 && o.fit_axis) {
     const Neighbours known = neighbours(true);
     const std::vector<std::size_t>& ids = known.ids;
     const GrainGrid& grid = known.grid;
     const HoleAxisOptions axis_options;
+    const std::size_t stride = std::max<std::size_t>(1, ids.size() / 64);
+    std::vector<HoleAxisFit> refits(ids.size());
+    double across = 0, along_z = 0, shortfall = 0;
+    for (int round = 0; round < 2; ++round) {
+      const std::size_t step = round == 0 ? stride : 1;
 #pragma omp parallel
-    {
-      GrainWindow window;
-      std::vector<const HoledSphere*> near;
-#pragma omp for schedule(dynamic, 16)
-      for (std::size_t k = 0; k < ids.size(); ++k) {
-        GrainFit& f = grains[ids[k]].fit;
-        near.clear();
-        grid.near(f.sphere.centre, 1, [&](std::size_t j) {
-          if (j != k) near.push_back(&grains[ids[j]].start);
-        });
-        window_of(stack, f.sphere, axis_options.within * f.sphere.radius, near, true, vs, window);
-        const HoleAxisFit refined = fit_hole_axis(window, f, axis_options);
-        if (refined.converged && std::isfinite(refined.sigma)) {
-          f.sphere.axis = refined.axis;
-          f.axis_sigma = refined.sigma;
+      {
+        GrainWindow window;
+        std::vector<const HoledSphere*> near;
+#pragma omp for schedule(dynamic, 4)
+        for (std::size_t k = 0; k < ids.size(); k += step) {
+          const GrainFit& f = grains[ids[k]].fit;
+          const double reach = axis_options.within * f.sphere.radius;
+          near.clear();
+          grid.near(f.sphere.centre, 1, [&](std::size_t j) {
+            const HoledSphere& s = grains[ids[j]].start;
+            const double blur = round == 0 ? s.blur : std::max(across, along_z);
+            if (j != k && (s.centre - f.sphere.centre).norm() < reach + s.radius + 5 * blur) {
+              near.push_back(&s);
+            }
+          });
+          const auto others = [&](const Eigen::Vector3d& p) {
+            double sum = 0;
+            for (const HoledSphere* s : near) {
+              if (round == 0) {
+                if ((p - s->centre).norm() < s->radius + 4 * s->blur) sum += s->value(p);
+                continue;
+              }
+              HoledSphere seen = *s;
+              seen.radius += shortfall;
+              if ((p - s->centre).norm() < seen.radius + 5 * std::max(across, along_z)) {
+                sum += blurred_grain_fraction(p, seen, across, along_z, true);
+              }
+            }
+            return sum;
+          };
+          inner_window(stack, f.sphere.centre, reach, others, vs, window);
+          refits[k] = fit_hole_axis(window, f, axis_options);
         }
+      }
+      if (round == 1) break;
+      std::vector<double> a, z, r;
+      for (std::size_t k = 0; k < ids.size(); k += stride) {
+        if (!refits[k].converged) continue;
+        a.push_back(refits[k].blur_across);
+        z.push_back(refits[k].blur_along_z);
+        r.push_back(refits[k].radius - grains[ids[k]].fit.sphere.radius);
+      }
+      if (a.empty()) break;  // no refit converged: the sample's refits stand
+      const auto median = [](std::vector<double>& v) {
+        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+        return v[v.size() / 2];
+      };
+      across = median(a);
+      along_z = median(z);
+      shortfall = median(r);
+    }
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const HoleAxisFit& r = refits[k];
+      GrainFit& f = grains[ids[k]].fit;
+      if (r.converged && std::isfinite(r.sigma)) {
+        f.sphere.axis = r.axis;
+        f.axis_sigma = r.sigma;
       }
     }
   }

@@ -10,7 +10,6 @@
 
 #include "commands.hpp"
 #include "comparison_report.hpp"
-#include "granmem/calibration/distribution_distance.hpp"
 #include "granmem/calibration/friction_fit.hpp"
 #include "granmem/calibration/friction_series.hpp"
 #include "granmem/core/atomic_file.hpp"
@@ -280,15 +279,6 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     const fs::path best_path = friction_run_path(series.dir, best);
     const TrajectoryReader best_run(best_path);
     const CycleObservables at_fit = cycle_observables(best_run, observe);
-    const std::vector<double> sim_dr =
-        noisy_dr(at_fit, fit_options.noise_shape, fit.noise_sigma, fit_options.seed + 7);
-    const double ks = ks_distance(measured.dr, sim_dr);
-    const double w1 = wasserstein1_distance(measured.dr, sim_dr);
-    double ks_rot = std::nan(""), w1_rot = std::nan("");
-    if (!measured.rot_disp.empty() && !at_fit.rot_disp.empty()) {
-      ks_rot = ks_distance(measured.rot_disp, at_fit.rot_disp);
-      w1_rot = wasserstein1_distance(measured.rot_disp, at_fit.rot_disp);
-    }
     const std::size_t simulations = mu.size() + (std::count(mu.begin(), mu.end(), best) ? 0 : 1);
 
     // Tables: the summaries per run, and the figures.
@@ -332,10 +322,18 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                  "over the window, grain diameters"});
     }
     std::vector<fs::path> figures = calibration_figures(out, fit, mu);
-    const std::vector<fs::path> compared =
+    // The distances at the fit: the run at the fitted mu_s with the fitted locating noise.
+    const Comparison compared =
         compare_runs(experiment, best_run, "experiment", "DEM mu_s = " + json_number(best), observe,
                      fit_options.noise_shape, fit.noise_sigma, out);
-    figures.insert(figures.end(), compared.begin(), compared.end());
+    figures.insert(figures.end(), compared.written.begin(), compared.written.end());
+    auto distance = [&](const std::string& q, bool wasserstein) {
+      const auto it = compared.distances.find(q);
+      if (it == compared.distances.end()) return std::nan("");
+      return wasserstein ? it->second.second : it->second.first;
+    };
+    const double ks = distance("dr", false), w1 = distance("dr", true);
+    const double ks_rot = distance("rot_disp", false), w1_rot = distance("rot_disp", true);
 
     {
       AtomicFile f(out / "summary.json");

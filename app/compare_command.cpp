@@ -56,9 +56,9 @@ void add_compare(CLI::App& app) {
     } else {
       o.window = parse_int_range(args->window, "--window");
     }
-    const auto written = compare_runs(a, b, args->label_a, args->label_b, o,
+    const Comparison c = compare_runs(a, b, args->label_a, args->label_b, o,
                                       Eigen::Vector3d::Ones(), 0.0, args->out);
-    std::cout << "wrote " << written.size() << " files in " << args->out << "\n";
+    std::cout << "wrote " << c.written.size() << " files in " << args->out << "\n";
   });
 }
 

@@ -52,11 +52,10 @@ bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cy
 
 }  // namespace
 
-std::vector<fs::path> compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
-                                   const std::string& label_a, const std::string& label_b,
-                                   const ObservableOptions& observe,
-                                   const Eigen::Vector3d& noise_shape, double sigma,
-                                   const fs::path& dir) {
+Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
+                        const std::string& label_a, const std::string& label_b,
+                        const ObservableOptions& observe, const Eigen::Vector3d& noise_shape,
+                        double sigma, const fs::path& dir) {
   ObservableOptions oa = observe, ob = observe;
   oa.rotations = a.header().has_axis || a.header().has_orientation;
   ob.rotations = b.header().has_axis || b.header().has_orientation;
@@ -80,6 +79,7 @@ std::vector<fs::path> compare_runs(const TrajectoryReader& a, const TrajectoryRe
   Column& ks_p = t.add("ks_p");
   Column& w1 = t.add("wasserstein1", "d");
   std::vector<std::string> names;
+  Comparison result;
   auto compare = [&](const std::string& name, const std::vector<double>& u,
                      const std::vector<double>& v) {
     if (u.empty() || v.empty()) return;
@@ -96,6 +96,7 @@ std::vector<fs::path> compare_runs(const TrajectoryReader& a, const TrajectoryRe
     ks.values.push_back(d);
     ks_p.values.push_back(ks_p_value(d, su.count, sv.count));
     w1.values.push_back(wasserstein1_distance(u, v));
+    result.distances[name] = {d, w1.values.back()};
     std::cout << std::setprecision(3) << std::setw(10) << name << ": median " << su.median << " vs "
               << sv.median << " d, KS " << d << ", Wasserstein-1 " << w1.values.back() << " d\n";
   };
@@ -110,7 +111,8 @@ std::vector<fs::path> compare_runs(const TrajectoryReader& a, const TrajectoryRe
        "end-of-cycle displacements over cycles " + std::to_string(observe.window.first) + "-" +
            std::to_string(observe.window.second) + ", lengths in grain diameters",
        legend});
-  std::vector<fs::path> written{dir / "distances.csv"};
+  std::vector<fs::path>& written = result.written;
+  written.push_back(dir / "distances.csv");
   auto add = [&](const std::vector<fs::path>& files) {
     written.insert(written.end(), files.begin(), files.end());
   };
@@ -175,7 +177,7 @@ std::vector<fs::path> compare_runs(const TrajectoryReader& a, const TrajectoryRe
                       "rotational displacement after a cycle [grain diameter]",
                       "Single-axis and full rotations"));
   }
-  return written;
+  return result;
 }
 
 std::vector<fs::path> calibration_figures(const fs::path& dir, const FrictionFit& fit,

@@ -2,7 +2,9 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "granmem/calibration/cycle_observables.hpp"
@@ -18,11 +20,16 @@ namespace granmem::app {
 // at the end of the last cycle when the run has no full-compression store beside it), and
 // for simulations one-axis against full rotations (Fig. 6). `b`'s displacements get the
 // locating noise `sigma` (voxels, `noise_shape`), as the friction fit sees them. Prints a
-// line per quantity; returns the files written.
-std::vector<std::filesystem::path> compare_runs(
-    const TrajectoryReader& a, const TrajectoryReader& b, const std::string& label_a,
-    const std::string& label_b, const ObservableOptions& observe,
-    const Eigen::Vector3d& noise_shape, double sigma, const std::filesystem::path& dir);
+// line per quantity.
+struct Comparison {
+  std::vector<std::filesystem::path> written;
+  // quantity (dr, rot_disp) -> KS and Wasserstein-1 (grain diameters) distances
+  std::map<std::string, std::pair<double, double>> distances;
+};
+Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
+                        const std::string& label_a, const std::string& label_b,
+                        const ObservableOptions& observe, const Eigen::Vector3d& noise_shape,
+                        double sigma, const std::filesystem::path& dir);
 
 // The friction fit's figure: the simulated CDF values at three of the experiment's deciles
 // against mu_s, the experiment's values beside them.

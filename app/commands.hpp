@@ -15,7 +15,11 @@ void add_import(CLI::App& app);
 void add_info(CLI::App& app);
 void add_analyze(CLI::App& app);
 void add_export(CLI::App& app);
-void add_simulate(CLI::App& app);
+// Returns its settings, which `calibrate` reads for the simulated twin.
+struct SimulateSettings;
+SimulateSettings add_simulate(CLI::App& app);
+void add_calibrate(CLI::App& app, const SimulateSettings& twin);
+void add_compare(CLI::App& app);
 void add_locate(CLI::App& app);
 void add_track(CLI::App& app);
 void add_render(CLI::App& app);

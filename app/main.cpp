@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/version.hpp"
+#include "simulation_settings.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"granmem: tracked grains and DEM runs of cyclically compressed packings"};
@@ -24,7 +25,9 @@ int main(int argc, char** argv) {
   granmem::app::add_info(app);
   granmem::app::add_analyze(app);
   granmem::app::add_export(app);
-  granmem::app::add_simulate(app);
+  const granmem::app::SimulateSettings twin = granmem::app::add_simulate(app);
+  granmem::app::add_calibrate(app, twin);
+  granmem::app::add_compare(app);
   granmem::app::add_locate(app);
   granmem::app::add_track(app);
   granmem::app::add_render(app);

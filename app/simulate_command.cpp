@@ -15,6 +15,7 @@
 #include "granmem/core/units.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
 #include "granmem/sim/deposit.hpp"
+#include "simulation_settings.hpp"
 
 namespace granmem::app {
 namespace {
@@ -22,104 +23,6 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void request_stop(int) {
   g_stop.store(true);
-}
-
-// Every option as text, as given or defaulted: it is parsed with its unit below, stored
-// in the checkpoint, and read back from it on --resume.
-struct SimulateArgs {
-  std::map<std::string, std::string> value;  // option name -> text
-};
-
-struct OptionSpec {
-  const char* name;
-  const char* default_value;
-  const char* help;
-};
-// The defaults are the paper's table and protocol.
-const OptionSpec kOptions[] = {
-    {"grains", "2000", "number of grains"},
-    {"cycles", "10", "compression cycles"},
-    {"amplitude", "1%", "wall amplitude A: a length (0.15cm) or a fraction of the box (1%)"},
-    {"drive", "asymmetric", "asymmetric (0 -> A -> 0) or symmetric (0 -> A/2 -> -A/2 -> 0)"},
-    {"wall-motion", "cosine", "cosine (smooth) or linear"},
-    {"period", "auto", "cycle period (25ms...), or auto: the inertial number below"},
-    {"inertial-number", "1e-3", "quasi-static limit for the automatic period"},
-    {"box", "15cm", "side of the square box"},
-    {"diameter", "0.5cm", "grain diameter"},
-    {"polydispersity", "0", "radii uniform in r(1 +- p)"},
-    {"density", "1.18g/cm^3", "grain density"},
-    {"lid-mass", "1kg", "mass of the free lid (0: no lid)"},
-    {"k-n", "4e6g/s^2", "normal spring constant"},
-    {"restitution-n", "0.2", "normal restitution coefficient"},
-    {"restitution-t", "0.5", "tangential restitution coefficient"},
-    {"kt-over-kn", "0.714285714285714", "tangential over normal spring constant (5/7)"},
-    {"mu-s", "0.2", "sliding friction between grains"},
-    {"mu-r", "0.01", "rolling friction"},
-    {"mu-t", "0.001", "twisting friction"},
-    {"beta", "0.5", "shape parameter of rolling and twisting"},
-    {"wall-mu-s", "same", "sliding friction on walls and lid (same: as between grains)"},
-    {"wall-mu-r", "same", "rolling friction on walls and lid"},
-    {"wall-mu-t", "same", "twisting friction on walls and lid"},
-    {"dt", "25us", "time step"},
-    {"skin", "0.05cm", "neighbour-list skin"},
-    {"gravity", "9.81m/s^2", "gravity"},
-    {"seed", "1", "seed of the deposition"},
-    {"settled-energy", "1e-13J", "kinetic energy per grain below which a packing is settled"},
-    {"settling-damping", "5", "drag rate while settling, 1/s"},
-    {"full-compression", "false", "also write frames at full compression"},
-    {"track", "", "grain ids sampled inside cycles, comma list"},
-    {"samples-per-cycle", "0", "in-cycle samples of the tracked grains"},
-    {"checkpoint-every", "0", "cycles between checkpoints (0: at the end and on Ctrl-C)"},
-    {"checkpoint", "", "checkpoint file (default <out>.checkpoint.h5)"},
-    {"out", "run.h5", "end-of-cycle trajectory store"},
-};
-
-// What makes the packing and its physics: fixed for a run, and for runs started from it.
-const char* const kPackingOptions[] = {"grains",
-                                       "box",
-                                       "diameter",
-                                       "polydispersity",
-                                       "density",
-                                       "lid-mass",
-                                       "k-n",
-                                       "restitution-n",
-                                       "restitution-t",
-                                       "kt-over-kn",
-                                       "mu-s",
-                                       "mu-r",
-                                       "mu-t",
-                                       "beta",
-                                       "wall-mu-s",
-                                       "wall-mu-r",
-                                       "wall-mu-t",
-                                       "dt",
-                                       "skin",
-                                       "gravity",
-                                       "seed",
-                                       "settled-energy",
-                                       "settling-damping"};
-
-double number(const std::map<std::string, std::string>& v, const std::string& name) {
-  const Quantity q = parse_quantity(v.at(name), "--" + name);
-  if (!q.unit.empty()) throw Error("--" + name + " '" + v.at(name) + "': expected a plain number");
-  return q.value;
-}
-double si(const std::map<std::string, std::string>& v, const std::string& name, Dimension d,
-          const char* default_unit = "") {
-  return parse_si(v.at(name), d, default_unit, "--" + name);
-}
-std::int64_t whole(const std::map<std::string, std::string>& v, const std::string& name) {
-  const double x = number(v, name);
-  if (x != std::floor(x) || x < 0 || x > 9e15) {
-    throw Error("--" + name + " '" + v.at(name) + "': expected a whole number >= 0");
-  }
-  return std::int64_t(x);
-}
-bool yes_no(const std::map<std::string, std::string>& v, const std::string& name) {
-  const std::string& x = v.at(name);
-  if (x == "true" || x == "yes" || x == "on" || x == "1") return true;
-  if (x == "false" || x == "no" || x == "off" || x == "0") return false;
-  throw Error("--" + name + " '" + x + "': expected true or false");
 }
 
 // The files a run writes must be distinct, must not be the checkpoint it starts from, and
@@ -145,28 +48,6 @@ void check_outputs(const std::vector<std::filesystem::path>& outputs,
   }
 }
 
-PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
-  PhysicsOptions p;
-  p.contact.k_n = si(v, "k-n", Dimension::stiffness);
-  p.contact.restitution_n = number(v, "restitution-n");
-  p.contact.restitution_t = number(v, "restitution-t");
-  p.contact.k_t_over_k_n = number(v, "kt-over-kn");
-  p.contact.mu_s = number(v, "mu-s");
-  p.contact.mu_r = number(v, "mu-r");
-  p.contact.mu_t = number(v, "mu-t");
-  p.contact.beta = number(v, "beta");
-  auto wall = [&](const char* name, double grain) {
-    return v.at(name) == "same" ? grain : number(v, name);
-  };
-  p.wall = {wall("wall-mu-s", p.contact.mu_s), wall("wall-mu-r", p.contact.mu_r),
-            wall("wall-mu-t", p.contact.mu_t)};
-  p.density = si(v, "density", Dimension::density);
-  p.gravity = si(v, "gravity", Dimension::acceleration);
-  p.dt = si(v, "dt", Dimension::time);
-  p.skin = si(v, "skin", Dimension::length);
-  return p;
-}
-
 std::string duration_text(double seconds) {
   const auto s = std::llround(seconds);
   char buf[32];
@@ -179,14 +60,15 @@ std::string duration_text(double seconds) {
 
 }  // namespace
 
-void add_simulate(CLI::App& app) {
+SimulateSettings add_simulate(CLI::App& app) {
   auto args = std::make_shared<SimulateArgs>();
   auto threads = std::make_shared<int>(0);
   auto resume = std::make_shared<std::string>();
   CLI::App* cmd = app.add_subcommand(
       "simulate", "Deposit grains in the box under a lid and compress them cyclically (DEM)");
   std::map<std::string, CLI::Option*> given;
-  for (const OptionSpec& o : kOptions) {
+  for (std::size_t k = 0; k < kSimulateOptionCount; ++k) {
+    const OptionSpec& o = kSimulateOptions[k];
     args->value[o.name] = o.default_value;
     given[o.name] = cmd->add_option(std::string("--") + o.name, args->value[o.name], o.help)
                         ->capture_default_str();
@@ -239,7 +121,8 @@ void add_simulate(CLI::App& app) {
                     "between cycles (--resume finishes that run)");
       }
       // The packing and its physics are the checkpoint's; the protocol is new.
-      for (const char* name : kPackingOptions) {
+      for (std::size_t k = 0; k < kPackingOptionCount; ++k) {
+        const char* name = kPackingOptions[k];
         const auto it = trained.settings.find(name);
         if (it == trained.settings.end()) {
           throw Error(*start_from + ": has no setting '" + name +
@@ -259,14 +142,9 @@ void add_simulate(CLI::App& app) {
                 << " of its run)\n";
     }
     const PhysicsOptions physics = physics_from(v);
-    const double box = si(v, "box", Dimension::length);
-    const double radius = 0.5 * si(v, "diameter", Dimension::length);
-    if (!(box > 0)) throw Error("--box '" + v.at("box") + "': must be positive");
-    if (!(radius > 0)) throw Error("--diameter '" + v.at("diameter") + "': must be positive");
-    const double polydispersity = number(v, "polydispersity");
-    if (!(polydispersity >= 0 && polydispersity < 1)) {
-      throw Error("--polydispersity " + v.at("polydispersity") + ": must be in [0, 1)");
-    }
+    const DepositOptions d = deposit_from(v);
+    const double box = d.box_side;
+    const double radius = d.radius;
     const std::string out = v.at("out");
     std::string checkpoint = v.at("checkpoint");
     if (checkpoint.empty()) {
@@ -275,15 +153,6 @@ void add_simulate(CLI::App& app) {
       v["checkpoint"] = checkpoint;
     }
 
-    DepositOptions d;
-    d.grains = whole(v, "grains");
-    d.radius = radius;
-    d.polydispersity = polydispersity;
-    d.box_side = box;
-    d.lid_mass = si(v, "lid-mass", Dimension::mass);
-    d.seed = std::uint64_t(whole(v, "seed"));
-    d.settled_energy = si(v, "settled-energy", Dimension::energy);
-    d.settling_damping = number(v, "settling-damping");
     physics.validate("simulate", d.radius * (1 - d.polydispersity));
     const double box_y = sim ? sim->container().size.y() : box;
     const double lid_mass =
@@ -292,30 +161,7 @@ void add_simulate(CLI::App& app) {
     // Every setting is checked before the packing is made.
     CyclicOptions c;
     c.cycles = whole(v, "cycles");
-    const std::string& amplitude = v.at("amplitude");
-    c.drive.amplitude =
-        !amplitude.empty() && amplitude.back() == '%'
-            ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") /
-                  100 * box_y
-            : si(v, "amplitude", Dimension::length);
-    c.drive.symmetry = parse_drive_symmetry(v.at("drive"));
-    c.drive.shape = parse_drive_shape(v.at("wall-motion"));
-    if (v.at("period") == "auto") {
-      if (!(number(v, "inertial-number") > 0)) {
-        throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
-      }
-      // Under the lid the confining pressure is its weight over the box; the lateral stress
-      // just beneath it, about half that, is the smallest in the packing. Without a lid, the
-      // weight of one layer of grains.
-      const double pressure = lid_mass > 0 ? lid_mass * physics.gravity / (box * box)
-                                           : physics.density * 0.6 * physics.gravity * 2 * radius;
-      const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_y, 2 * radius,
-                                                   0.5 * pressure, physics.density);
-      c.drive.period =
-          WallDrive::period_for_speed(c.drive.amplitude, speed, c.drive.symmetry, c.drive.shape);
-    } else {
-      c.drive.period = si(v, "period", Dimension::time);
-    }
+    c.drive = drive_from(v, physics, box, box_y, lid_mass, radius);
     c.out = out;
     c.full_compression_frames = yes_no(v, "full-compression");
     std::stringstream track(v.at("track"));
@@ -391,6 +237,7 @@ void add_simulate(CLI::App& app) {
       std::cout << "wrote " << p.string() << "\n";
     std::cout << "wrote " << checkpoint << "\n";
   });
+  return {args, given};
 }
 
 }  // namespace granmem::app

@@ -10,9 +10,10 @@
 namespace granmem::h5 {
 namespace {
 
-// HDF5 prints its error stack to stderr by default; granmem reports one line instead.
+// HDF5 prints its error stack to stderr by default; granmem reports one line instead. The
+// setting is per thread in a thread-safe HDF5 (calibrate writes runs from several).
 void quiet_hdf5() {
-  static const bool done = [] {
+  thread_local const bool done = [] {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     return true;
   }();

@@ -9,12 +9,6 @@
 
 namespace granmem {
 
-double Random::normal() {
-  // Box-Muller; 1 - u keeps the logarithm finite.
-  const double u = 1.0 - uniform(), v = uniform();
-  return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * M_PI * v);
-}
-
 DepositProgress print_deposit_progress(std::ostream& out) {
   auto last = std::make_shared<double>(-1);
   return [&out, last](const std::string& stage, double t, double energy) {

@@ -3,9 +3,9 @@
 #include <cstdint>
 #include <functional>
 #include <ostream>
-#include <random>
 #include <string>
 
+#include "granmem/core/random.hpp"
 #include "granmem/sim/simulation.hpp"
 
 namespace granmem {
@@ -55,18 +55,5 @@ Grains insert_grains(const DepositOptions& options, const PhysicsOptions& physic
 double packing_fraction(const Simulation& sim);
 // Top of the packing: the lid, or the highest grain top.
 double packing_height(const Simulation& sim);
-
-// Uniform and normal deviates from the 64-bit Mersenne Twister, whose raw sequence the
-// C++ standard fixes, transformed here rather than by <random>'s distributions, whose
-// results differ between standard libraries.
-class Random {
- public:
-  explicit Random(std::uint64_t seed) : engine_(seed) {}
-  double uniform() { return double(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
-  double normal();
-
- private:
-  std::mt19937_64 engine_;
-};
 
 }  // namespace granmem

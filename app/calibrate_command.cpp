@@ -1,0 +1,384 @@
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "commands.hpp"
+#include "comparison_report.hpp"
+#include "granmem/calibration/friction_fit.hpp"
+#include "granmem/calibration/friction_series.hpp"
+#include "granmem/core/atomic_file.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/sim/checkpoint.hpp"
+#include "parse.hpp"
+#include "simulation_settings.hpp"
+
+namespace granmem::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Options of `simulate` that calibrate sets itself, or that make no sense for a twin.
+const std::set<std::string> kNotTwin{"out",  "checkpoint", "checkpoint-every",  "cycles",
+                                     "mu-s", "track",      "samples-per-cycle", "full-compression"};
+
+std::vector<double> parse_frictions(const std::string& text) {
+  if (trim(text).empty()) throw Error("--mu-s: the range of frictions is empty");
+  std::vector<double> mu;
+  for (const Quantity& q : parse_quantity_list(text, "--mu-s")) {
+    if (!q.unit.empty() || !(q.value > 0) || !std::isfinite(q.value)) {
+      throw Error("--mu-s '" + text + "': expected positive frictions, e.g. 0.05,0.1,0.2,0.4");
+    }
+    mu.push_back(q.value);
+  }
+  std::sort(mu.begin(), mu.end());
+  if (mu.empty()) throw Error("--mu-s: the range of frictions is empty");
+  if (std::adjacent_find(mu.begin(), mu.end()) != mu.end()) {
+    throw Error("--mu-s '" + text + "': a friction is listed twice");
+  }
+  return mu;
+}
+
+// Settings that make the protocol: a pseudo-experiment simulated by granmem says what it
+// used, and they must agree with the twin's.
+void check_against_experiment(const RunHeader& experiment, const std::string& file,
+                              const std::map<std::string, std::string>& twin, double box) {
+  for (const char* key : {"grains", "box", "diameter", "amplitude", "drive", "wall-motion",
+                          "lid-mass", "period", "inertial-number", "polydispersity"}) {
+    const auto it = experiment.parameters.find(std::string("simulate/") + key);
+    if (it != experiment.parameters.end() && it->second != twin.at(key)) {
+      throw Error(file + ": the experiment was simulated with --" + key + " " + it->second +
+                  ", the twin has " + twin.at(key) + " (set it in the config's [simulate])");
+    }
+  }
+  if (experiment.box && is_physical_length_unit(experiment.length_unit)) {
+    const double m = metres_per(experiment.length_unit);
+    for (int a = 0; a < 2; ++a) {
+      const double edge = experiment.box->edges(a) * m;
+      if (std::abs(edge - box) > 0.05 * box) {
+        throw Error(file + ": the experiment's box is " + std::to_string(edge * 100) +
+                    " cm wide, the twin's " + std::to_string(box * 100) + " cm (--box)");
+      }
+    }
+  }
+}
+
+std::string json_number(double x) {
+  if (!std::isfinite(x)) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+std::string json_text(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+}  // namespace
+
+void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
+  struct Args {
+    std::string experiment, out, mu_s = "0.03,0.05,0.08,0.12,0.2,0.3,0.5", window, noise = "auto",
+                                 wall_distance = "0";
+    std::map<std::string, std::string> twin;
+    bool keep_drift = false;
+    int threads = 0, degree = 2;
+  };
+  auto args = std::make_shared<Args>();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Fit the DEM's sliding friction mu_s so that its end-of-cycle displacements match an "
+      "experiment's (Ceres), with a 95% interval");
+  cmd->add_option("--experiment", args->experiment, "the experiment's trajectory store (.h5)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out,-o", args->out, "output folder")->required();
+  cmd->add_option("--mu-s", args->mu_s, "the frictions simulated, comma list")
+      ->capture_default_str();
+  cmd->add_option("--window", args->window,
+                  "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
+                  "experiment's last 10");
+  cmd->add_option("--noise", args->noise,
+                  "locating noise added to the simulated positions: none, fit, a value in voxels, "
+                  "or auto (fit for scans, none for simulations)")
+      ->capture_default_str();
+  cmd->add_option("--wall-distance", args->wall_distance,
+                  "leave out grains closer than this to a container face (with a unit)")
+      ->capture_default_str();
+  cmd->add_flag("--keep-drift", args->keep_drift,
+                "keep the packing's mean displacement (default: subtracted, both sides)");
+  cmd->add_option("--degree", args->degree,
+                  "degree of the polynomial in log mu_s through the runs' summaries")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "runs at once (default: all cores)");
+  // The twin's settings: as `simulate` takes them, here or in the config's [simulate].
+  std::map<std::string, CLI::Option*> given;
+  for (std::size_t k = 0; k < kSimulateOptionCount; ++k) {
+    const OptionSpec& o = kSimulateOptions[k];
+    if (kNotTwin.count(o.name)) continue;
+    args->twin[o.name] = o.default_value;
+    given[o.name] = cmd->add_option(std::string("--") + o.name, args->twin[o.name],
+                                    std::string("twin: ") + o.help)
+                        ->capture_default_str()
+                        ->group("Simulated twin (or the config's [simulate])");
+  }
+
+  cmd->callback([args, given, simulate, cmd] {
+    // The twin: simulate's defaults, then the config's [simulate], then calibrate's own.
+    std::map<std::string, std::string> v = simulate.args->value;
+    for (const auto& [name, option] : simulate.given) {
+      if (option->count() == 0) v[name] = simulate.args->value.at(name);
+    }
+    for (const auto& [name, option] : given) {
+      if (option->count() > 0) v[name] = args->twin.at(name);
+    }
+    const std::vector<double> mu = parse_frictions(args->mu_s);
+    if (mu.size() < std::size_t(args->degree) + 2) {
+      throw Error("--mu-s: " + std::to_string(mu.size()) + " frictions; the fit needs at least " +
+                  std::to_string(args->degree + 2) + " (degree " + std::to_string(args->degree) +
+                  " + 1, and one more to measure the runs' scatter)");
+    }
+    const TrajectoryReader experiment(args->experiment);
+    const RunHeader& h = experiment.header();
+    const PhysicsOptions physics = physics_from(v);
+    const DepositOptions d = deposit_from(v);
+    physics.validate("calibrate", d.radius * (1 - d.polydispersity));
+    check_against_experiment(h, args->experiment, v, d.box_side);
+
+    // Observables: the same options on both sides, lengths in the twin's grain diameter.
+    ObservableOptions observe;
+    observe.diameter = 2 * d.radius;
+    observe.motion.subtract_drift = !args->keep_drift;
+    observe.motion.wall_distance =
+        parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
+    observe.rotations = h.has_axis || h.has_orientation;
+    const auto& steps = experiment.steps();
+    if (args->window.empty()) {
+      observe.window = {std::max(steps.front() + 1, steps.back() - 9), steps.back()};
+    } else {
+      observe.window = parse_int_range(args->window, "--window");
+    }
+    if (observe.window.first < 1) throw Error("--window: cycles start at 1");
+    if (observe.motion.wall_distance > 0) {
+      observe.motion.box =
+          Box{Eigen::Vector3d::Zero(), Eigen::Vector3d(d.box_side, d.box_side, 1e9)};
+    }
+    const CycleObservables measured = [&] {
+      ObservableOptions o = observe;
+      o.motion.box.reset();  // the experiment's own container, if any
+      if (o.motion.wall_distance > 0 && !h.box) {
+        throw Error(args->experiment + ": --wall-distance needs the experiment's box");
+      }
+      return cycle_observables(experiment, o);
+    }();
+
+    FrictionFitOptions fit_options;
+    fit_options.degree = args->degree;
+    const std::string noise = args->noise == "auto" ? (h.voxel_size ? "fit" : "none") : args->noise;
+    if (noise == "fit" || (noise != "none" && !noise.empty())) {
+      if (!h.voxel_size) {
+        throw Error("--noise " + noise + ": the experiment has no voxel size (not from scans)");
+      }
+      fit_options.noise_shape = *h.voxel_size * metres_per(h.length_unit) / observe.diameter;
+      fit_options.noise = noise == "fit" ? NoiseModel::fitted : NoiseModel::fixed;
+      if (noise != "fit") {
+        const Quantity q = parse_quantity(noise, "--noise");
+        if (!q.unit.empty() || !(q.value >= 0)) {
+          throw Error("--noise '" + noise + "': expected none, fit, auto or voxels (0.05)");
+        }
+        fit_options.noise_sigma = q.value;
+      }
+    } else if (noise != "none") {
+      throw Error("--noise '" + noise + "': expected none, fit, auto or voxels");
+    }
+
+    const fs::path out(args->out);
+    fs::create_directories(out / "runs");
+    FrictionSeriesOptions series;
+    series.dir = out / "runs";
+    series.walls_follow = wall_friction_follows(v);
+    series.parallel = args->threads;
+    series.protocol.cycles = observe.window.second;
+    series.protocol.drive = drive_from(v, physics, d.box_side, d.box_side, d.lid_mass, d.radius);
+    for (const auto& [key, value] : v)
+      series.protocol.parameters["simulate/" + key] = value;
+    series.protocol.validate(d.box_side, physics.dt);
+
+    std::cerr << "calibrate: twin of " << args->experiment << ": " << d.grains << " grains, box "
+              << d.box_side * 100 << " cm, A = " << series.protocol.drive.amplitude * 100
+              << " cm, cycles 1-" << series.protocol.cycles << " (window " << observe.window.first
+              << ":" << observe.window.second << "), mu_s " << args->mu_s << "\n";
+    // One packing for every friction, kept in DIR so that a second call reuses it.
+    const fs::path packing_path = out / "packing.checkpoint.h5";
+    std::optional<Simulation> packing;
+    if (fs::exists(packing_path)) {
+      ProtocolState state;
+      packing.emplace(read_checkpoint(packing_path, &state));
+      if (state.settings != v) {
+        throw Error(packing_path.string() + ": deposited with other settings; remove it or " +
+                    "choose another --out");
+      }
+      std::cerr << "reusing the packing of " << packing_path.string() << "\n";
+    } else {
+      std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
+      packing.emplace(deposit(d, physics, nullptr, print_deposit_progress(std::cerr)));
+      ProtocolState state;
+      state.settings = v;
+      write_checkpoint(packing_path, *packing, state);
+    }
+
+    // Runs already in DIR with the same settings are reused: a stopped calibration goes on.
+    auto finished = [&](double m) {
+      const fs::path p = friction_run_path(series.dir, m);
+      if (!fs::exists(p)) return false;
+      const TrajectoryReader r(p);
+      for (const auto& [key, value] : series.protocol.parameters) {
+        const auto it = r.header().parameters.find(key);
+        if (it == r.header().parameters.end() || it->second != value) return false;
+      }
+      return r.steps().back() >= series.protocol.cycles;
+    };
+    auto run_all = [&](const std::vector<double>& frictions) {
+      std::vector<double> todo;
+      for (double m : frictions)
+        if (!finished(m)) todo.push_back(m);
+      if (todo.size() < frictions.size()) {
+        std::cerr << "reusing " << frictions.size() - todo.size() << " finished runs in "
+                  << series.dir.string() << "\n";
+      }
+      if (todo.empty()) return;
+      run_friction_series(*packing, todo, series, [&](std::size_t k, const CyclicProgress& p) {
+        std::cerr << "mu_s " << todo[k] << ": cycle " << p.cycle << "/" << p.cycles << "  "
+                  << std::scientific << std::setprecision(2) << p.particle_steps_per_second
+                  << std::defaultfloat << std::setprecision(6) << " particle-steps/s  "
+                  << std::llround(p.seconds_left) << " s left\n";
+      });
+    };
+    run_all(mu);
+    std::vector<FrictionRun> runs;
+    for (double m : mu)
+      runs.push_back(
+          {m, cycle_observables(TrajectoryReader(friction_run_path(series.dir, m)), observe)});
+    const FrictionFit fit = fit_friction(measured, runs, fit_options);
+
+    // The twin at the fitted friction: what the distances and the figures compare.
+    char rounded[32];  // three digits: the run's file name, and a second call finds it
+    std::snprintf(rounded, sizeof rounded, "%.3g", fit.mu_s);
+    const double best = std::stod(rounded);
+    run_all({best});
+    const fs::path best_path = friction_run_path(series.dir, best);
+    const TrajectoryReader best_run(best_path);
+    const CycleObservables at_fit = cycle_observables(best_run, observe);
+    const std::size_t simulations = mu.size() + (std::count(mu.begin(), mu.end(), best) ? 0 : 1);
+
+    // Tables: the summaries per run, and the figures.
+    {
+      Table t;
+      Column& level = t.add("threshold_dr", "d");
+      Column& exp_cdf = t.add("experiment_cdf");
+      Column& exp_err = t.add("experiment_error");
+      Column& model = t.add("fit_cdf");
+      std::vector<Column*> per_run;
+      for (double m : mu)
+        per_run.push_back(&t.add("cdf_mu_s_" + json_number(m)));
+      for (std::size_t j = 0; j < fit.thresholds.size(); ++j) {
+        level.values.push_back(fit.thresholds[j]);
+        exp_cdf.values.push_back(fit.experiment_cdf[j]);
+        exp_err.values.push_back(fit.experiment_error[j]);
+        model.values.push_back(fit.model_cdf[j]);
+        for (std::size_t k = 0; k < mu.size(); ++k)
+          per_run[k]->values.push_back(fit.run_cdf[k][j]);
+      }
+      write_csv(t, out / "cdf_summaries.csv",
+                {"smoothed CDF of the end-of-cycle displacement dr (grain diameters) at the "
+                 "experiment's deciles, per simulated mu_s (with the fitted locating noise)"});
+      Table r;
+      Column& m = r.add("mu_s");
+      Column& n = r.add("n", "", true);
+      Column& mean = r.add("mean_dr", "d");
+      Column& median = r.add("median_dr", "d");
+      Column& mean_rot = r.add("mean_rot_disp", "d");
+      for (std::size_t k = 0; k <= runs.size(); ++k) {
+        const CycleObservables& o = k < runs.size() ? runs[k].observables : at_fit;
+        const Summary s = summarize(o.dr);
+        m.values.push_back(k < runs.size() ? runs[k].mu_s : best);
+        n.values.push_back(double(s.count));
+        mean.values.push_back(s.mean);
+        median.values.push_back(s.median);
+        mean_rot.values.push_back(summarize(o.rot_disp).mean);
+      }
+      write_csv(r, out / "runs.csv",
+                {"per simulated mu_s (the last row: at the fit): end-of-cycle displacements "
+                 "over the window, grain diameters"});
+    }
+    std::vector<fs::path> figures = calibration_figures(out, fit, mu);
+    // The distances at the fit: the run at the fitted mu_s with the fitted locating noise.
+    const Comparison compared =
+        compare_runs(experiment, best_run, "experiment", "DEM mu_s = " + json_number(best), observe,
+                     fit_options.noise_shape, fit.noise_sigma, out);
+    figures.insert(figures.end(), compared.written.begin(), compared.written.end());
+    auto distance = [&](const std::string& q, bool wasserstein) {
+      const auto it = compared.distances.find(q);
+      if (it == compared.distances.end()) return std::nan("");
+      return wasserstein ? it->second.second : it->second.first;
+    };
+    const double ks = distance("dr", false), w1 = distance("dr", true);
+    const double ks_rot = distance("rot_disp", false), w1_rot = distance("rot_disp", true);
+
+    {
+      AtomicFile f(out / "summary.json");
+      std::ofstream j(f.temp_path());
+      j << "{\n  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
+        << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
+        << "],\n  \"mu_s_interval_method\": " << json_text(fit.method)
+        << ",\n  \"n_simulations\": " << simulations << ",\n  \"mu_s_simulated\": [";
+      for (std::size_t k = 0; k < mu.size(); ++k)
+        j << (k ? ", " : "") << json_number(mu[k]);
+      j << "],\n  \"converged\": " << (fit.converged ? "true" : "false")
+        << ",\n  \"chi2\": " << json_number(fit.chi2) << ",\n  \"dof\": " << json_number(fit.dof)
+        << ",\n  \"overdispersion\": " << json_number(fit.overdispersion)
+        << ",\n  \"noise_model\": " << json_text(noise)
+        << ",\n  \"noise_sigma_voxel\": " << json_number(fit.noise_sigma)
+        << ",\n  \"noise_sigma_error\": " << json_number(fit.noise_sigma_error)
+        << ",\n  \"distances_at_fit\": {\"ks_dr\": " << json_number(ks)
+        << ", \"wasserstein1_dr\": " << json_number(w1)
+        << ", \"ks_rot_disp\": " << json_number(ks_rot)
+        << ", \"wasserstein1_rot_disp\": " << json_number(w1_rot)
+        << ", \"length_unit\": \"grain diameter\"},\n  \"window\": [" << observe.window.first
+        << ", " << observe.window.second << "],\n  \"experiment\": " << json_text(args->experiment)
+        << ",\n  \"settings\": {";
+      bool first = true;
+      for (const auto& [key, value] : v) {
+        j << (first ? "" : ", ") << json_text(key) << ": " << json_text(value);
+        first = false;
+      }
+      j << "}\n}\n";
+      j.close();
+      f.commit();
+    }
+    std::cout << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval "
+              << fit.mu_s_ci95[0] << " - " << fit.mu_s_ci95[1] << ", " << simulations
+              << " simulations" << (fit.converged ? "" : ", fit NOT converged") << ")\n"
+              << "  at the fit: KS " << ks << ", Wasserstein-1 " << w1
+              << " d (end-of-cycle dr); chi2 " << fit.chi2 << " for " << fit.dof
+              << " dof; realization scatter x" << fit.overdispersion << "\n";
+    if (fit.noise_sigma > 0) {
+      std::cout << "  locating noise " << fit.noise_sigma << " +- " << fit.noise_sigma_error
+                << " voxel\n";
+    }
+    std::cout << "wrote " << (out / "summary.json").string() << ", runs.csv, cdf_summaries.csv, "
+              << figures.size() << " figure files\n";
+  });
+}
+
+}  // namespace granmem::app

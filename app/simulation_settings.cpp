@@ -1,0 +1,171 @@
+#include "simulation_settings.hpp"
+
+#include <cmath>
+#include <iterator>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem::app {
+
+const OptionSpec kSimulateOptions[] = {
+    {"grains", "2000", "number of grains"},
+    {"cycles", "10", "compression cycles"},
+    {"amplitude", "1%", "wall amplitude A: a length (0.15cm) or a fraction of the box (1%)"},
+    {"drive", "asymmetric", "asymmetric (0 -> A -> 0) or symmetric (0 -> A/2 -> -A/2 -> 0)"},
+    {"wall-motion", "cosine", "cosine (smooth) or linear"},
+    {"period", "auto", "cycle period (25ms...), or auto: the inertial number below"},
+    {"inertial-number", "1e-3", "quasi-static limit for the automatic period"},
+    {"box", "15cm", "side of the square box"},
+    {"diameter", "0.5cm", "grain diameter"},
+    {"polydispersity", "0", "radii uniform in r(1 +- p)"},
+    {"density", "1.18g/cm^3", "grain density"},
+    {"lid-mass", "1kg", "mass of the free lid (0: no lid)"},
+    {"k-n", "4e6g/s^2", "normal spring constant"},
+    {"restitution-n", "0.2", "normal restitution coefficient"},
+    {"restitution-t", "0.5", "tangential restitution coefficient"},
+    {"kt-over-kn", "0.714285714285714", "tangential over normal spring constant (5/7)"},
+    {"mu-s", "0.2", "sliding friction between grains"},
+    {"mu-r", "0.01", "rolling friction"},
+    {"mu-t", "0.001", "twisting friction"},
+    {"beta", "0.5", "shape parameter of rolling and twisting"},
+    {"wall-mu-s", "same", "sliding friction on walls and lid (same: as between grains)"},
+    {"wall-mu-r", "same", "rolling friction on walls and lid"},
+    {"wall-mu-t", "same", "twisting friction on walls and lid"},
+    {"dt", "25us", "time step"},
+    {"skin", "0.05cm", "neighbour-list skin"},
+    {"gravity", "9.81m/s^2", "gravity"},
+    {"seed", "1", "seed of the deposition"},
+    {"settled-energy", "1e-13J", "kinetic energy per grain below which a packing is settled"},
+    {"settling-damping", "5", "drag rate while settling, 1/s"},
+    {"full-compression", "false", "also write frames at full compression"},
+    {"track", "", "grain ids sampled inside cycles, comma list"},
+    {"samples-per-cycle", "0", "in-cycle samples of the tracked grains"},
+    {"checkpoint-every", "0", "cycles between checkpoints (0: at the end and on Ctrl-C)"},
+    {"checkpoint", "", "checkpoint file (default <out>.checkpoint.h5)"},
+    {"out", "run.h5", "end-of-cycle trajectory store"},
+};
+const std::size_t kSimulateOptionCount = std::size(kSimulateOptions);
+
+const char* const kPackingOptions[] = {"grains",
+                                       "box",
+                                       "diameter",
+                                       "polydispersity",
+                                       "density",
+                                       "lid-mass",
+                                       "k-n",
+                                       "restitution-n",
+                                       "restitution-t",
+                                       "kt-over-kn",
+                                       "mu-s",
+                                       "mu-r",
+                                       "mu-t",
+                                       "beta",
+                                       "wall-mu-s",
+                                       "wall-mu-r",
+                                       "wall-mu-t",
+                                       "dt",
+                                       "skin",
+                                       "gravity",
+                                       "seed",
+                                       "settled-energy",
+                                       "settling-damping"};
+const std::size_t kPackingOptionCount = std::size(kPackingOptions);
+
+double number(const std::map<std::string, std::string>& v, const std::string& name) {
+  const Quantity q = parse_quantity(v.at(name), "--" + name);
+  if (!q.unit.empty()) throw Error("--" + name + " '" + v.at(name) + "': expected a plain number");
+  return q.value;
+}
+double si(const std::map<std::string, std::string>& v, const std::string& name, Dimension d,
+          const char* default_unit) {
+  return parse_si(v.at(name), d, default_unit, "--" + name);
+}
+std::int64_t whole(const std::map<std::string, std::string>& v, const std::string& name) {
+  const double x = number(v, name);
+  if (x != std::floor(x) || x < 0 || x > 9e15) {
+    throw Error("--" + name + " '" + v.at(name) + "': expected a whole number >= 0");
+  }
+  return std::int64_t(x);
+}
+bool yes_no(const std::map<std::string, std::string>& v, const std::string& name) {
+  const std::string& x = v.at(name);
+  if (x == "true" || x == "yes" || x == "on" || x == "1") return true;
+  if (x == "false" || x == "no" || x == "off" || x == "0") return false;
+  throw Error("--" + name + " '" + x + "': expected true or false");
+}
+
+PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
+  PhysicsOptions p;
+  p.contact.k_n = si(v, "k-n", Dimension::stiffness);
+  p.contact.restitution_n = number(v, "restitution-n");
+  p.contact.restitution_t = number(v, "restitution-t");
+  p.contact.k_t_over_k_n = number(v, "kt-over-kn");
+  p.contact.mu_s = number(v, "mu-s");
+  p.contact.mu_r = number(v, "mu-r");
+  p.contact.mu_t = number(v, "mu-t");
+  p.contact.beta = number(v, "beta");
+  auto wall = [&](const char* name, double grain) {
+    return v.at(name) == "same" ? grain : number(v, name);
+  };
+  p.wall = {wall("wall-mu-s", p.contact.mu_s), wall("wall-mu-r", p.contact.mu_r),
+            wall("wall-mu-t", p.contact.mu_t)};
+  p.density = si(v, "density", Dimension::density);
+  p.gravity = si(v, "gravity", Dimension::acceleration);
+  p.dt = si(v, "dt", Dimension::time);
+  p.skin = si(v, "skin", Dimension::length);
+  return p;
+}
+
+DepositOptions deposit_from(const std::map<std::string, std::string>& v) {
+  DepositOptions d;
+  d.grains = whole(v, "grains");
+  d.radius = 0.5 * si(v, "diameter", Dimension::length);
+  d.polydispersity = number(v, "polydispersity");
+  d.box_side = si(v, "box", Dimension::length);
+  d.lid_mass = si(v, "lid-mass", Dimension::mass);
+  d.seed = std::uint64_t(whole(v, "seed"));
+  d.settled_energy = si(v, "settled-energy", Dimension::energy);
+  d.settling_damping = number(v, "settling-damping");
+  if (!(d.box_side > 0)) throw Error("--box '" + v.at("box") + "': must be positive");
+  if (!(d.radius > 0)) throw Error("--diameter '" + v.at("diameter") + "': must be positive");
+  if (!(d.polydispersity >= 0 && d.polydispersity < 1)) {
+    throw Error("--polydispersity " + v.at("polydispersity") + ": must be in [0, 1)");
+  }
+  return d;
+}
+
+WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsOptions& physics,
+                     double box, double box_y, double lid_mass, double radius) {
+  WallDrive d;
+  const std::string& amplitude = v.at("amplitude");
+  d.amplitude =
+      !amplitude.empty() && amplitude.back() == '%'
+          ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") / 100 *
+                box_y
+          : si(v, "amplitude", Dimension::length);
+  d.symmetry = parse_drive_symmetry(v.at("drive"));
+  d.shape = parse_drive_shape(v.at("wall-motion"));
+  if (v.at("period") == "auto") {
+    if (!(number(v, "inertial-number") > 0)) {
+      throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
+    }
+    // Under the lid the confining pressure is its weight over the box; the lateral stress
+    // just beneath it, about half that, is the smallest in the packing. Without a lid, the
+    // weight of one layer of grains.
+    const double pressure = lid_mass > 0 ? lid_mass * physics.gravity / (box * box)
+                                         : physics.density * 0.6 * physics.gravity * 2 * radius;
+    const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_y, 2 * radius,
+                                                 0.5 * pressure, physics.density);
+    d.period = WallDrive::period_for_speed(d.amplitude, speed, d.symmetry, d.shape);
+  } else {
+    d.period = si(v, "period", Dimension::time);
+  }
+  return d;
+}
+
+bool wall_friction_follows(const std::map<std::string, std::string>& v) {
+  return v.at("wall-mu-s") == "same";
+}
+
+}  // namespace granmem::app

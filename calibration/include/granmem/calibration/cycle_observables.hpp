@@ -1,0 +1,75 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/rotation/grain_motion.hpp"
+
+namespace granmem {
+
+// The paper's observables of a run, experimental or simulated, computed the same way for
+// both: what the friction fit and the comparison read.
+struct ObservableOptions {
+  // Drift removal, wall exclusion, hole-contact policy (the paper leaves grains locked
+  // through their hole out of the rotations).
+  MotionOptions motion{false, 0, std::nullopt, HoleContactPolicy::exclude_rotations};
+  // Cycles (frame labels) whose end-of-cycle displacements c-1 -> c are pooled, inclusive;
+  // the paper pools 10 cycles after 500. Default (0, 0): every cycle of the run.
+  std::pair<std::int64_t, std::int64_t> window{0, 0};
+  // Grain diameter, m: the unit of every length below, and the lever arm of rotational
+  // displacements (angle times d/2, the same for every grain, so that a fitted radius a few
+  // percent off does not bias them). 0: twice the run's median grain radius.
+  double diameter = 0;
+  bool rotations = true;  // rotational displacements (an error if the run has no axes)
+};
+
+// Lengths in grain diameters.
+struct CycleObservables {
+  double diameter = 0;  // m, the length unit below
+  std::pair<std::int64_t, std::int64_t> window{0, 0};
+  // End-of-cycle translational displacements pooled over the window, one per grain per
+  // cycle, with the grain (index into the run) each belongs to: grains are the units of
+  // the bootstrap, their cycles being correlated.
+  Vectors3 displacement;
+  std::vector<double> dr;
+  std::vector<std::size_t> dr_grain;
+  // Single-axis rotational displacements (angle between the cavity axes times d/2),
+  // pooled likewise; empty when not asked for.
+  std::vector<double> rot_disp;
+  std::vector<std::size_t> rot_grain;
+  // Runs with orientations (simulations): the full rotation angle times d/2, pooled
+  // likewise, beside the single-axis one (the paper's Fig. 6).
+  std::vector<double> full_rot_disp;
+  // Every cycle of the run: mean displacement from the previous end-of-cycle frame.
+  std::vector<std::int64_t> cycle;
+  std::vector<double> mean_dr, mean_rot_disp;  // NaN where no grain was measured
+  std::size_t grains = 0;                      // grains in the run
+};
+
+// Throws Error (naming the file) for a run without physical lengths (voxels without a
+// voxel size), a window the run does not hold, or rotations asked of a run without axes.
+CycleObservables cycle_observables(const TrajectoryReader& run, const ObservableOptions& options);
+
+// The displacement field at full compression: every grain's displacement and single-axis
+// rotational displacement from the end of cycle c - 1 to full compression in cycle c, and
+// its position at full compression (lengths in diameters). `end_of_cycle` is the run,
+// `full_compression` the store of its frames at full compression (same grains).
+struct DisplacementField {
+  std::int64_t cycle = 0;
+  Vectors3 position;             // at full compression, in diameters from the run's origin
+  std::vector<double> dr;        // in diameters
+  std::vector<double> rot_disp;  // in diameters; NaN where not measured
+};
+DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
+                                         const TrajectoryReader& full_compression,
+                                         std::int64_t cycle, const ObservableOptions& options);
+
+// Twice the median finite grain radius of the run, m (Error if it has none).
+double median_diameter(const TrajectoryReader& run);
+
+}  // namespace granmem

@@ -1,0 +1,162 @@
+#include "granmem/calibration/cycle_observables.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Metres per unit of the run's positions; Error for voxels without a voxel size, whose
+// lengths are not comparable with anything (slices are often coarser than pixels).
+double metres_per_length(const TrajectoryReader& run) {
+  const RunHeader& h = run.header();
+  if (is_physical_length_unit(h.length_unit)) return metres_per(h.length_unit);
+  throw Error(run.file_name() + ": positions are in " + h.length_unit +
+              " without a physical length; import or track it with --voxel-size");
+}
+
+double diameter_for(const TrajectoryReader& run, const ObservableOptions& options) {
+  return options.diameter > 0 ? options.diameter : median_diameter(run);
+}
+
+// The motion options in the run's own length unit.
+MotionOptions in_run_units(MotionOptions motion, double metres) {
+  motion.wall_distance /= metres;
+  return motion;
+}
+
+void check_rotations(const TrajectoryReader& run, const ObservableOptions& options) {
+  if (options.rotations && !run.header().has_axis && !run.header().has_orientation) {
+    throw Error(run.file_name() +
+                ": has no cavity axes or orientations, so no rotations (leave rotations out)");
+  }
+}
+
+}  // namespace
+
+double median_diameter(const TrajectoryReader& run) {
+  std::vector<double> r;
+  for (double x : run.header().radius) {
+    if (std::isfinite(x) && x > 0) r.push_back(x);
+  }
+  if (r.empty()) throw Error(run.file_name() + ": no grain radius; give the grain diameter");
+  std::nth_element(r.begin(), r.begin() + std::ptrdiff_t(r.size() / 2), r.end());
+  return 2 * r[r.size() / 2] * metres_per_length(run);
+}
+
+CycleObservables cycle_observables(const TrajectoryReader& run, const ObservableOptions& options) {
+  const RunHeader& h = run.header();
+  const double metres = metres_per_length(run);
+  check_rotations(run, options);
+  const std::vector<std::int64_t>& steps = run.steps();
+  if (steps.size() < 2) {
+    throw Error(run.file_name() + ": needs at least two end-of-cycle frames, has " +
+                std::to_string(steps.size()));
+  }
+  CycleObservables o;
+  o.diameter = diameter_for(run, options);
+  o.grains = h.grain_count();
+  o.window = options.window;
+  if (o.window == std::pair<std::int64_t, std::int64_t>{0, 0}) o.window = {steps[1], steps.back()};
+  const auto [first, last] = o.window;
+  if (first > last) {
+    throw Error("window " + std::to_string(first) + ":" + std::to_string(last) +
+                ": the first cycle is after the last");
+  }
+  // Every cycle of the window needs its frame and the one before it.
+  for (std::int64_t c = first; c <= last; ++c) {
+    for (std::int64_t s : {c - 1, c}) {
+      if (std::find(steps.begin(), steps.end(), s) == steps.end()) {
+        throw Error(run.file_name() + ": window " + std::to_string(first) + ":" +
+                    std::to_string(last) + " needs the frame of cycle " + std::to_string(s) +
+                    ", which the run does not have (cycles " + std::to_string(steps.front()) +
+                    " to " + std::to_string(steps.back()) + ")");
+      }
+    }
+  }
+
+  const double to_d = metres / o.diameter;  // run's length unit -> diameters
+  const MotionOptions motion = in_run_units(options.motion, metres);
+  std::vector<Eigen::Vector3d> displacement;
+  Frame before = run.read_frame(0);
+  for (std::size_t t = 1; t < steps.size(); ++t) {
+    Frame after = run.read_frame(t);
+    const bool consecutive = steps[t] == steps[t - 1] + 1;
+    if (consecutive) {
+      const FrameMotion m = grain_motion(h, before, after, motion);
+      const bool pooled = steps[t] >= first && steps[t] <= last;
+      double sum_dr = 0, sum_rot = 0;
+      std::size_t n_rot = 0;
+      for (std::size_t k = 0; k < m.grain.size(); ++k) {
+        const double dr = m.dr[k] * to_d;
+        const double rot = options.rotations ? m.theta_axis[k] * 0.5 : kNaN;  // angle d/2 / d
+        sum_dr += dr;
+        if (std::isfinite(rot)) {
+          sum_rot += rot;
+          ++n_rot;
+        }
+        if (!pooled) continue;
+        displacement.push_back(m.displacement.row(Eigen::Index(k)).transpose() * to_d);
+        o.dr.push_back(dr);
+        o.dr_grain.push_back(m.grain[k]);
+        if (std::isfinite(rot)) {
+          o.rot_disp.push_back(rot);
+          o.rot_grain.push_back(m.grain[k]);
+        }
+        if (!m.theta_full.empty()) o.full_rot_disp.push_back(m.theta_full[k] * 0.5);
+      }
+      o.cycle.push_back(steps[t]);
+      o.mean_dr.push_back(m.grain.empty() ? kNaN : sum_dr / double(m.grain.size()));
+      o.mean_rot_disp.push_back(n_rot ? sum_rot / double(n_rot) : kNaN);
+    }
+    before = std::move(after);
+  }
+  o.displacement.resize(Eigen::Index(displacement.size()), 3);
+  for (std::size_t k = 0; k < displacement.size(); ++k)
+    o.displacement.row(Eigen::Index(k)) = displacement[k].transpose();
+  if (o.dr.empty()) {
+    throw Error(run.file_name() + ": no grain is seen at both ends of a cycle of the window");
+  }
+  return o;
+}
+
+DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
+                                         const TrajectoryReader& full_compression,
+                                         std::int64_t cycle, const ObservableOptions& options) {
+  const RunHeader& h = end_of_cycle.header();
+  if (full_compression.header().id != h.id) {
+    throw Error(full_compression.file_name() + ": not the same grains as " +
+                end_of_cycle.file_name());
+  }
+  check_rotations(end_of_cycle, options);
+  auto frame_of = [&](const TrajectoryReader& run, std::int64_t step) {
+    const auto& s = run.steps();
+    const auto it = std::find(s.begin(), s.end(), step);
+    if (it == s.end()) {
+      throw Error(run.file_name() + ": has no frame of cycle " + std::to_string(step));
+    }
+    return run.read_frame(std::size_t(it - s.begin()));
+  };
+  const Frame before = frame_of(end_of_cycle, cycle - 1);
+  const Frame full = frame_of(full_compression, cycle);
+  const double metres = metres_per_length(end_of_cycle);
+  const double to_d = metres / diameter_for(end_of_cycle, options);
+  const FrameMotion m = grain_motion(h, before, full, in_run_units(options.motion, metres));
+  DisplacementField f;
+  f.cycle = cycle;
+  f.position.resize(Eigen::Index(m.grain.size()), 3);
+  for (std::size_t k = 0; k < m.grain.size(); ++k) {
+    f.position.row(Eigen::Index(k)) = full.position.row(Eigen::Index(m.grain[k])) * to_d;
+    f.dr.push_back(m.dr[k] * to_d);
+    f.rot_disp.push_back(options.rotations ? m.theta_axis[k] * 0.5 : kNaN);
+  }
+  return f;
+}
+
+}  // namespace granmem

@@ -1,0 +1,211 @@
+#include "granmem/calibration/figures.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "granmem/core/atomic_file.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
+
+namespace granmem {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string quoted(const std::string& text) {
+  std::string q = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+// Writes the data and the script (whose `plot` part is `body`, data in `<name>.dat`), runs
+// gnuplot once for the PNG and once for the SVG, each into a temporary file renamed into
+// place.
+std::vector<fs::path> draw(const fs::path& dir, const std::string& name, const std::string& data,
+                           const std::string& body, const std::string& size = "800,600") {
+  fs::create_directories(dir);
+  const fs::path dat = dir / (name + ".dat"), gp = dir / (name + ".gp");
+  {
+    AtomicFile f(dat);
+    std::ofstream(f.temp_path()) << data;
+    f.commit();
+  }
+  {
+    AtomicFile f(gp);
+    std::ofstream out(f.temp_path());
+    out << "# " << name << ": drawn by granmem; `gnuplot " << name << ".gp` draws it again\n"
+        << "if (!exists(\"term\")) term = \"pngcairo\"\n"
+        << "if (term eq \"svg\") { set terminal svg size " << size
+        << " font \"Sans,13\" background rgb \"white\"; set output \"" << name << ".svg\" }"
+        << " else { set terminal pngcairo size " << size << " font \"Sans,12\"; set output \""
+        << name << ".png\" }\n"
+        << "set datafile missing \"nan\"\nset key top right\nset grid\n"
+        << body;
+    f.commit();
+  }
+  std::vector<fs::path> written{dat, gp};
+  for (const std::string term : {"pngcairo", "svg"}) {
+    const std::string ext = term == "svg" ? ".svg" : ".png";
+    const fs::path target = dir / (name + ext);
+    AtomicFile f(target);
+    // gnuplot runs in `dir` so that the script's relative names hold; its output goes to a
+    // temporary name that is then renamed into place.
+    const std::string command = "cd " + quoted(dir.string()) + " && gnuplot -e " +
+                                quoted("term='" + term + "'") + " " + quoted(gp.filename()) +
+                                " 2> " + quoted(name + ".log") + " && mv " + quoted(name + ext) +
+                                " " + quoted(f.temp_path().filename());
+    if (std::system(command.c_str()) != 0) {
+      std::ifstream log(dir / (name + ".log"));
+      std::string first;
+      std::getline(log, first);
+      throw Error("gnuplot failed to draw " + target.string() +
+                  (first.empty() ? " (is gnuplot installed? Debian: gnuplot-nox)" : ": " + first));
+    }
+    f.commit();
+    written.push_back(target);
+  }
+  fs::remove(dir / (name + ".log"));
+  return written;
+}
+
+}  // namespace
+
+std::vector<fs::path> plot_log_pdfs(const fs::path& dir, const std::string& name,
+                                    const std::vector<Sample>& samples, const std::string& x_label,
+                                    const std::string& title, int bins) {
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (const Sample& s : samples) {
+    for (double v : s.values) {
+      if (std::isfinite(v) && v > 0) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    }
+  }
+  if (!(hi > lo)) throw Error(name + ": no positive values to draw");
+  DensityOptions o;
+  o.bins = std::size_t(bins);
+  o.scale = BinScale::logarithmic;
+  o.range = std::make_pair(lo, hi);
+  std::ostringstream data, plot;
+  data.precision(8);
+  plot << "set title " << quoted(title) << "\nset logscale xy\nset format xy \"10^{%T}\"\n"
+       << "set xlabel " << quoted(x_label) << "\nset ylabel \"probability density\"\nplot ";
+  const char* marks[] = {"7", "6", "5", "4", "9", "8"};
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Table pdf = probability_density(samples[k].values, o);
+    data << "# " << samples[k].label << "\n# bin_center density\n";
+    for (std::size_t r = 0; r < pdf.rows(); ++r) {
+      if (pdf["density"].values[r] > 0) {
+        data << pdf["bin_center"].values[r] << " " << pdf["density"].values[r] << "\n";
+      }
+    }
+    data << "\n\n";
+    plot << (k ? ", " : "") << quoted(name + ".dat") << " index " << k
+         << " using 1:2 with linespoints pt " << marks[k % 6] << " title "
+         << quoted(samples[k].label);
+  }
+  plot << "\n";
+  return draw(dir, name, data.str(), plot.str());
+}
+
+std::vector<fs::path> plot_relaxation(const fs::path& dir, const std::string& name,
+                                      const std::vector<Relaxation>& runs,
+                                      const std::string& y_label, const std::string& title) {
+  std::ostringstream data, plot, fits;
+  data.precision(8);
+  plot << "set title " << quoted(title)
+       << "\nset logscale xy\nset format y \"10^{%T}\"\nset xlabel \"cycle\"\nset ylabel "
+       << quoted(y_label) << "\n";
+  const char* marks[] = {"7", "2", "5", "4"};
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const Relaxation& r = runs[k];
+    data << "# " << r.label << "\n# cycle mean-steady\n";
+    for (std::size_t i = 0; i < r.cycle.size(); ++i) {
+      const double excess = r.mean[i] - r.fit.steady;
+      if (std::isfinite(excess) && excess > 0) data << r.cycle[i] << " " << excess << "\n";
+    }
+    data << "\n\n";
+    char label[160];
+    std::snprintf(label, sizeof label, "%s: n^{-%.2f [%.2f, %.2f]}", r.label.c_str(),
+                  r.fit.exponent, r.fit.exponent_ci95[0], r.fit.exponent_ci95[1]);
+    fits << ", " << r.fit.amplitude << " * x**(-" << r.fit.exponent << ") with lines dt 2 lc "
+         << k + 1 << " lw 2 title " << quoted(label);
+  }
+  plot << "plot ";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    plot << (k ? ", " : "") << quoted(name + ".dat") << " index " << k
+         << " using 1:2 with points pt " << marks[k % 4] << " lc " << k + 1 << " title "
+         << quoted(runs[k].label);
+  }
+  plot << fits.str() << "\n";
+  return draw(dir, name, data.str(), plot.str());
+}
+
+std::vector<fs::path> plot_fields(const fs::path& dir, const std::string& name,
+                                  const std::vector<Field>& panels, const std::string& axis_label,
+                                  const std::string& value_label) {
+  // One colour scale for all panels: up to the 98th percentile, so that a few grains at the
+  // wall do not wash the pattern out.
+  std::vector<double> all;
+  for (const Field& f : panels) {
+    for (double v : f.value)
+      if (std::isfinite(v)) all.push_back(v);
+  }
+  if (all.empty()) throw Error(name + ": no values to draw");
+  std::sort(all.begin(), all.end());
+  const double top = all[std::size_t(0.98 * double(all.size() - 1))];
+  std::ostringstream data, plot;
+  data.precision(8);
+  plot << "set multiplot layout 1," << panels.size() << "\nset size ratio -1\nunset key\n"
+       << "set palette rgbformulae 33,13,10\nset cbrange [0:" << top << "]\nset cblabel "
+       << quoted(value_label) << "\nset xlabel " << quoted("y " + axis_label) << "\nset ylabel "
+       << quoted("z " + axis_label) << "\n";
+  for (std::size_t k = 0; k < panels.size(); ++k) {
+    const Field& f = panels[k];
+    data << "# " << f.title << "\n# y z value\n";
+    for (std::size_t i = 0; i < f.value.size(); ++i) {
+      if (std::isfinite(f.value[i])) data << f.y[i] << " " << f.z[i] << " " << f.value[i] << "\n";
+    }
+    data << "\n\n";
+    plot << "set title " << quoted(f.title) << "\nplot " << quoted(name + ".dat") << " index " << k
+         << " using 1:2:3 with points pt 7 ps 0.8 palette\n";
+  }
+  plot << "unset multiplot\n";
+  const std::string size = std::to_string(520 * panels.size()) + ",520";
+  return draw(dir, name, data.str(), plot.str(), size);
+}
+
+std::vector<fs::path> plot_curves(const fs::path& dir, const std::string& name,
+                                  const std::vector<Curve>& curves, const std::string& x_label,
+                                  const std::string& y_label, const std::string& title,
+                                  bool log_x) {
+  std::ostringstream data, plot;
+  data.precision(8);
+  plot << "set title " << quoted(title) << "\nset xlabel " << quoted(x_label) << "\nset ylabel "
+       << quoted(y_label) << "\nset key outside right\n"
+       << (log_x ? "set logscale x\n" : "") << "plot ";
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const Curve& c = curves[k];
+    data << "# " << c.label << "\n";
+    for (std::size_t i = 0; i < c.x.size(); ++i)
+      data << c.x[i] << " " << c.y[i] << " " << (c.error.empty() ? 0.0 : c.error[i]) << "\n";
+    data << "\n\n";
+    plot << (k ? ", " : "") << quoted(name + ".dat") << " index " << k
+         << (c.error.empty()
+                 ? (c.points ? " using 1:2 with linespoints pt 7" : " using 1:2 with lines lw 2")
+                 : " using 1:2:3 with yerrorbars pt 7")
+         << " lc " << k + 1 << " title " << quoted(c.label);
+  }
+  plot << "\n";
+  return draw(dir, name, data.str(), plot.str(), "900,600");
+}
+
+}  // namespace granmem

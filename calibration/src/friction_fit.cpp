@@ -1,0 +1,384 @@
+#include "granmem/calibration/friction_fit.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/random.hpp"
+
+namespace granmem {
+namespace {
+
+double normal_cdf(double x) {
+  return 0.5 * std::erfc(-x * M_SQRT1_2);
+}
+
+// A sample's smoothed CDF at the thresholds, kept as sums per grain so that whole grains
+// can be resampled: F_j = sum_g S_gj / sum_g n_g.
+struct GrainSums {
+  Eigen::MatrixXd sum;    // grains x thresholds
+  Eigen::VectorXd count;  // values per grain
+  Eigen::VectorXd cdf() const { return sum.colwise().sum().transpose() / count.sum(); }
+};
+
+// Adds log(value) of grain `grain` (compact index) to the sums.
+void add_value(GrainSums& s, std::size_t grain, double log_value, const std::vector<double>& tau,
+               double width) {
+  for (std::size_t j = 0; j < tau.size(); ++j)
+    s.sum(Eigen::Index(grain), Eigen::Index(j)) += normal_cdf((tau[j] - log_value) / width);
+  s.count(Eigen::Index(grain)) += 1;
+}
+
+// Compact grain indices 0..G-1 for the grain labels of a sample.
+std::vector<std::size_t> compact(const std::vector<std::size_t>& grain, std::size_t* count) {
+  std::map<std::size_t, std::size_t> index;
+  std::vector<std::size_t> out(grain.size());
+  for (std::size_t k = 0; k < grain.size(); ++k)
+    out[k] = index.emplace(grain[k], index.size()).first->second;
+  *count = index.size();
+  return out;
+}
+
+// Covariance of the CDF values over resamples of whole grains.
+Eigen::MatrixXd bootstrap_covariance(const GrainSums& s, std::size_t resamples, Random& random) {
+  const Eigen::Index g = s.sum.rows(), j = s.sum.cols();
+  Eigen::MatrixXd f(Eigen::Index(resamples), j);
+  Eigen::VectorXd weight(g);
+  for (std::size_t b = 0; b < resamples; ++b) {
+    weight.setZero();
+    for (Eigen::Index k = 0; k < g; ++k)
+      weight(Eigen::Index(random.uniform() * double(g))) += 1;
+    f.row(Eigen::Index(b)) = (weight.transpose() * s.sum) / weight.dot(s.count);
+  }
+  const Eigen::MatrixXd centred = f.rowwise() - f.colwise().mean();
+  return centred.transpose() * centred / double(resamples - 1);
+}
+
+// The simulated runs' smoothed CDFs with the noise model, and their polynomial in
+// log(mu_s) across the runs.
+class SimulatedSummaries {
+ public:
+  SimulatedSummaries(const std::vector<FrictionRun>& runs, const std::vector<double>& tau,
+                     const FrictionFitOptions& o)
+      : runs_(runs), tau_(tau), o_(o) {
+    Random random(o.seed + 1);
+    const std::size_t copies = o.noise == NoiseModel::none ? 1 : o.noise_replicas;
+    for (const FrictionRun& r : runs) {
+      Eigen::MatrixXd z(r.observables.displacement.rows() * Eigen::Index(copies), 3);
+      for (Eigen::Index k = 0; k < z.size(); ++k)
+        z.data()[k] = random.normal();
+      normals_.push_back(std::move(z));
+    }
+    const Eigen::Index k = Eigen::Index(runs.size()), p = o.degree + 1;
+    for (const FrictionRun& r : runs)
+      centre_ += std::log(r.mu_s) / double(k);
+    Eigen::MatrixXd x(k, p);
+    for (Eigen::Index i = 0; i < k; ++i)
+      x.row(i) = powers(std::log(runs[std::size_t(i)].mu_s));
+    normal_inverse_ = (x.transpose() * x).inverse();
+    projector_ = normal_inverse_ * x.transpose();
+  }
+
+  // Sums per grain of run `k` at noise `sigma`.
+  GrainSums run_sums(std::size_t k, double sigma) const {
+    const CycleObservables& o = runs_[k].observables;
+    std::size_t grains = 0;
+    const std::vector<std::size_t> g = compact(o.dr_grain, &grains);
+    GrainSums s{Eigen::MatrixXd::Zero(Eigen::Index(grains), Eigen::Index(tau_.size())),
+                Eigen::VectorXd::Zero(Eigen::Index(grains))};
+    const Eigen::MatrixXd& z = normals_[k];
+    const Eigen::Index n = o.displacement.rows();
+    const Eigen::Index copies = z.rows() / std::max<Eigen::Index>(n, 1);
+    const Eigen::RowVector3d scale = M_SQRT2 * sigma * o_.noise_shape.transpose();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      for (Eigen::Index c = 0; c < copies; ++c) {
+        const Eigen::RowVector3d d =
+            o.displacement.row(i) + scale.cwiseProduct(z.row(i * copies + c));
+        const double dr = d.norm();
+        if (dr > 0) add_value(s, g[std::size_t(i)], std::log(dr), tau_, o_.kernel_width);
+      }
+    }
+    return s;
+  }
+
+  // Runs x thresholds, cached for the last sigma (Ceres varies one parameter at a time).
+  const Eigen::MatrixXd& run_cdfs(double sigma) const {
+    if (sigma != cached_sigma_ || cached_.size() == 0) {
+      cached_.resize(Eigen::Index(runs_.size()), Eigen::Index(tau_.size()));
+      for (std::size_t k = 0; k < runs_.size(); ++k)
+        cached_.row(Eigen::Index(k)) = run_sums(k, sigma).cdf().transpose();
+      cached_sigma_ = sigma;
+    }
+    return cached_;
+  }
+
+  Eigen::VectorXd predict(double log_mu, double sigma) const {
+    return (powers(log_mu) * projector_ * run_cdfs(sigma)).transpose();
+  }
+
+  // The covariance of the runs' residuals about the polynomial, sum_k r_k r_k^T / (runs -
+  // coefficients): sampling and realization noise together; empty without spare runs.
+  Eigen::MatrixXd residual_covariance(double sigma) const {
+    const Eigen::MatrixXd& f = run_cdfs(sigma);
+    const Eigen::Index k = f.rows(), spare = k - (o_.degree + 1);
+    if (spare <= 0) return {};
+    Eigen::MatrixXd x(k, o_.degree + 1);
+    for (Eigen::Index i = 0; i < k; ++i)
+      x.row(i) = powers(std::log(runs_[std::size_t(i)].mu_s));
+    const Eigen::MatrixXd r = f - x * (projector_ * f);
+    return r.transpose() * r / double(spare);
+  }
+
+  // Variance of the polynomial's prediction over that of one run: how much the fit across
+  // the runs averages their sampling noise away.
+  double leverage(double log_mu) const {
+    const Eigen::RowVectorXd x = powers(log_mu);
+    return (x * normal_inverse_ * x.transpose())(0, 0);
+  }
+
+ private:
+  Eigen::RowVectorXd powers(double log_mu) const {
+    Eigen::RowVectorXd x(o_.degree + 1);
+    for (int p = 0; p <= o_.degree; ++p)
+      x(p) = std::pow(log_mu - centre_, p);
+    return x;
+  }
+
+  const std::vector<FrictionRun>& runs_;
+  const std::vector<double>& tau_;
+  const FrictionFitOptions& o_;
+  std::vector<Eigen::MatrixXd> normals_;
+  double centre_ = 0;
+  Eigen::MatrixXd normal_inverse_, projector_;
+  mutable Eigen::MatrixXd cached_;
+  mutable double cached_sigma_ = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Whitened residuals L^-1 (F_sim(mu, sigma) - F_exp), C = L L^T.
+struct SummaryResidual {
+  const SimulatedSummaries* model;
+  Eigen::VectorXd target;
+  Eigen::MatrixXd whitening;
+  bool operator()(double const* const* p, double* r) const {
+    const Eigen::VectorXd d = model->predict(p[0][0], p[1][0]) - target;
+    Eigen::Map<Eigen::VectorXd>(r, d.size()) = whitening * d;
+    return true;
+  }
+};
+
+std::string format_number(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", x);
+  return text;
+}
+
+double quantile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  const double x = p * double(v.size() - 1);
+  const std::size_t i = std::size_t(x);
+  if (i + 1 >= v.size()) return v.back();
+  return v[i] + (x - double(i)) * (v[i + 1] - v[i]);
+}
+
+}  // namespace
+
+std::vector<double> noisy_dr(const CycleObservables& simulated, const Eigen::Vector3d& noise_shape,
+                             double sigma, std::uint64_t seed) {
+  Random random(seed);
+  std::vector<double> dr;
+  dr.reserve(std::size_t(simulated.displacement.rows()));
+  for (Eigen::Index i = 0; i < simulated.displacement.rows(); ++i) {
+    Eigen::Vector3d d = simulated.displacement.row(i).transpose();
+    if (sigma > 0) {
+      for (int a = 0; a < 3; ++a)
+        d(a) += M_SQRT2 * sigma * noise_shape(a) * random.normal();
+    }
+    dr.push_back(d.norm());
+  }
+  return dr;
+}
+
+FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<FrictionRun>& runs,
+                         const FrictionFitOptions& options) {
+  const FrictionFitOptions& o = options;
+  if (o.degree < 1) throw Error("friction fit: the polynomial degree must be at least 1");
+  if (runs.size() < std::size_t(o.degree) + 1) {
+    throw Error("friction fit: " + std::to_string(runs.size()) + " simulated runs, need at least " +
+                std::to_string(o.degree + 1) + " (a polynomial of degree " +
+                std::to_string(o.degree) + " in log mu_s)");
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const FrictionRun& r : runs) {
+    if (!(r.mu_s > 0)) throw Error("friction fit: mu_s must be positive");
+    if (r.observables.dr.empty()) throw Error("friction fit: a simulated run has no displacement");
+    lo = std::min(lo, std::log(r.mu_s));
+    hi = std::max(hi, std::log(r.mu_s));
+  }
+  if (!(hi > lo)) throw Error("friction fit: the runs must differ in mu_s");
+  if (o.probabilities.empty()) throw Error("friction fit: no CDF levels");
+
+  // The experiment's summaries and their sampling covariance.
+  std::vector<double> log_dr;
+  std::vector<std::size_t> grain_of;
+  for (std::size_t k = 0; k < experiment.dr.size(); ++k) {
+    if (experiment.dr[k] > 0 && std::isfinite(experiment.dr[k])) {
+      log_dr.push_back(std::log(experiment.dr[k]));
+      grain_of.push_back(experiment.dr_grain[k]);
+    }
+  }
+  if (log_dr.size() < 10 * o.probabilities.size()) {
+    throw Error("friction fit: " + std::to_string(log_dr.size()) +
+                " measured displacements, too few for " + std::to_string(o.probabilities.size()) +
+                " CDF levels");
+  }
+  std::vector<double> tau;
+  for (double p : o.probabilities)
+    tau.push_back(quantile(log_dr, p));
+  const Eigen::Index nj = Eigen::Index(tau.size());
+  std::size_t grains = 0;
+  const std::vector<std::size_t> g = compact(grain_of, &grains);
+  GrainSums exp_sums{Eigen::MatrixXd::Zero(Eigen::Index(grains), nj),
+                     Eigen::VectorXd::Zero(Eigen::Index(grains))};
+  for (std::size_t k = 0; k < log_dr.size(); ++k)
+    add_value(exp_sums, g[k], log_dr[k], tau, o.kernel_width);
+  const Eigen::VectorXd target = exp_sums.cdf();
+  Random random(o.seed);
+  const Eigen::MatrixXd exp_cov = bootstrap_covariance(exp_sums, o.bootstrap, random);
+
+  const SimulatedSummaries model(runs, tau, o);
+  const bool fit_noise = o.noise == NoiseModel::fitted;
+  double log_mu = 0.5 * (lo + hi);
+  double sigma = o.noise == NoiseModel::fixed ? o.noise_sigma : 0.0;
+
+  // Start from the best point of a grid (the experiment's errors only): the cost need not be
+  // convex in the noise.
+  {
+    const Eigen::VectorXd weight = exp_cov.diagonal().cwiseMax(1e-12).cwiseInverse();
+    std::vector<double> sigmas{sigma};
+    if (fit_noise) {
+      const double median = std::exp(quantile(log_dr, 0.5));
+      const double top = median / o.noise_shape.norm();
+      sigmas.clear();
+      for (int k = 0; k <= 16; ++k)
+        sigmas.push_back(top * k / 16.0);
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (double s : sigmas) {
+      for (int k = 0; k <= 24; ++k) {
+        const double m = lo + (hi - lo) * k / 24.0;
+        const Eigen::VectorXd d = model.predict(m, s) - target;
+        const double c = d.cwiseProduct(d).dot(weight);
+        if (c < best) {
+          best = c;
+          log_mu = m;
+          sigma = s;
+        }
+      }
+    }
+  }
+
+  FrictionFit fit;
+  ceres::Problem::Options po;
+  Eigen::MatrixXd run_cov;
+  // Two rounds: the simulation's covariance depends on the noise and, through the
+  // polynomial's leverage, on mu_s; both are taken at the previous round's fit.
+  for (int round = 0; round < 2; ++round) {
+    run_cov = Eigen::MatrixXd::Zero(nj, nj);
+    for (std::size_t k = 0; k < runs.size(); ++k)
+      run_cov +=
+          bootstrap_covariance(model.run_sums(k, sigma), o.bootstrap, random) / double(runs.size());
+    // A packing is one realization of a chaotic system: runs that differ only in friction
+    // scatter about any smooth trend by more than their grains' sampling error (a run may
+    // settle into a nearly reversible cycle, or not), and mostly along one direction (all
+    // CDF values at once). That excess, measured on the runs' residuals about the
+    // polynomial, is the realization noise; the experiment's packing has it too.
+    Eigen::MatrixXd excess = Eigen::MatrixXd::Zero(nj, nj);
+    const Eigen::MatrixXd residual = model.residual_covariance(sigma);
+    if (residual.size()) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(residual - run_cov);
+      excess = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+               eigen.eigenvectors().transpose();
+      fit.overdispersion = std::max(1.0, residual.trace() / run_cov.trace());
+    }
+    Eigen::MatrixXd cov = exp_cov + excess + model.leverage(log_mu) * (run_cov + excess);
+    cov.diagonal().array() += 1e-12;
+    const Eigen::MatrixXd whitening = cov.llt().matrixL().solve(Eigen::MatrixXd::Identity(nj, nj));
+
+    ceres::Problem problem(po);
+    auto* cost = new ceres::DynamicNumericDiffCostFunction<SummaryResidual, ceres::CENTRAL>(
+        new SummaryResidual{&model, target, whitening});
+    cost->AddParameterBlock(1);
+    cost->AddParameterBlock(1);
+    cost->SetNumResiduals(int(nj));
+    problem.AddResidualBlock(cost, nullptr, &log_mu, &sigma);
+    problem.SetParameterLowerBound(&log_mu, 0, lo);
+    problem.SetParameterUpperBound(&log_mu, 0, hi);
+    if (fit_noise) {
+      problem.SetParameterLowerBound(&sigma, 0, 0.0);
+    } else {
+      problem.SetParameterBlockConstant(&sigma);
+    }
+    ceres::Solver::Options so;
+    so.max_num_iterations = 100;
+    ceres::Solver::Summary summary;
+    ceres::Solve(so, &problem, &summary);
+    fit.converged = summary.termination_type == ceres::CONVERGENCE;
+    fit.chi2 = 2 * summary.final_cost;
+
+    if (round == 1) {
+      ceres::Covariance::Options co;
+      co.algorithm_type = ceres::DENSE_SVD;
+      co.null_space_rank = -1;
+      ceres::Covariance covariance(co);
+      std::vector<std::pair<const double*, const double*>> blocks{{&log_mu, &log_mu}};
+      if (fit_noise) blocks.push_back({&sigma, &sigma});
+      double var_mu = std::nan(""), var_sigma = std::nan("");
+      if (covariance.Compute(blocks, &problem)) {
+        covariance.GetCovarianceBlock(&log_mu, &log_mu, &var_mu);
+        if (fit_noise) covariance.GetCovarianceBlock(&sigma, &sigma, &var_sigma);
+      }
+      fit.dof = double(nj) - (fit_noise ? 2.0 : 1.0);
+      fit.error_scale = fit.dof > 0 ? std::max(1.0, std::sqrt(fit.chi2 / fit.dof)) : 1.0;
+      fit.log_mu_s_sigma = std::sqrt(var_mu) * fit.error_scale;
+      fit.noise_sigma_error = fit_noise ? std::sqrt(var_sigma) * fit.error_scale : 0.0;
+    }
+  }
+  fit.mu_s = std::exp(log_mu);
+  fit.mu_s_ci95 = {std::exp(log_mu - 1.96 * fit.log_mu_s_sigma),
+                   std::exp(log_mu + 1.96 * fit.log_mu_s_sigma)};
+  fit.noise_sigma = sigma;
+  fit.simulations = runs.size();
+  for (double t : tau)
+    fit.thresholds.push_back(std::exp(t));
+  const Eigen::VectorXd at_fit = model.predict(log_mu, sigma);
+  for (Eigen::Index j = 0; j < nj; ++j) {
+    fit.experiment_cdf.push_back(target(j));
+    fit.experiment_error.push_back(std::sqrt(exp_cov(j, j)));
+    fit.model_cdf.push_back(at_fit(j));
+  }
+  const Eigen::MatrixXd& per_run = model.run_cdfs(sigma);
+  for (Eigen::Index k = 0; k < per_run.rows(); ++k) {
+    const Eigen::VectorXd row = per_run.row(k).transpose();
+    fit.run_cdf.emplace_back(row.data(), row.data() + nj);
+  }
+  fit.method =
+      "Ceres generalized least squares on the smoothed CDF of log(dr) at the experiment's " +
+      std::to_string(nj) +
+      " quantiles, covariance from a bootstrap over grains of the experiment and of the "
+      "runs plus the realization noise measured on the runs' scatter about the fit across "
+      "frictions (x" +
+      format_number(fit.overdispersion) +
+      " the sampling variance); 95 % interval from Ceres' covariance of ln(mu_s)" +
+      std::string(fit.error_scale > 1 ? ", widened by sqrt(chi2/dof)" : "") +
+      (fit_noise ? "; locating noise fitted jointly" : "");
+  return fit;
+}
+
+}  // namespace granmem

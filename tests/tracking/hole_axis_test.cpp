@@ -119,6 +119,16 @@ TEST(HoleAxis, NoTiltUnderABlurWideOnTheGrainsScale) {
   EXPECT_NEAR(refit.blur_across, 1.0, 0.05);
   EXPECT_NEAR(refit.blur_along_z, 2.25, 0.1);
   EXPECT_NEAR(refit.radius, 6, 0.05);
+
+  // Started as locate starts it, from a sample's blurs and radius change (here off by a
+  // tenth): the same fit.
+  HoleAxisOptions near;
+  near.start = {1.1, 2.0, 0.7, 0, 0};
+  const HoleAxisFit again = fit_hole_axis(inner, start, near);
+  ASSERT_TRUE(again.converged);
+  EXPECT_LT(single_axis_angle(again.axis, refit.axis) / kDegree, 0.01);
+  EXPECT_NEAR(again.radius, refit.radius, 0.01);
+  EXPECT_NEAR(again.blur_along_z, refit.blur_along_z, 0.01);
 }
 
 TEST(HoleAxis, TooFewVoxelsGiveNoAxis) {

@@ -87,50 +87,14 @@ struct Candidate {
   bool fitted = false, active = true;
 };
 
-// The voxels within `reach` of grain `s`: with `model_neighbours`, each with how much of it
-// the neighbours leave clear (voxels they cover are left out: they say nothing of this
-// grain); without, only the voxels nearer this grain than any neighbour.
-void window_of(const Stack& stack, const HoledSphere& s, double reach,
-               const std::vector<const HoledSphere*>& near, bool model_neighbours,
-               const Eigen::Vector3d& vs, GrainWindow& window) {
-  const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
-  const Eigen::Vector3d lo = ((s.centre.array() - reach) / vs.array()).ceil().max(0.0);
-  const Eigen::Vector3d hi = ((s.centre.array() + reach) / vs.array()).floor().min(last);
-  window.points.clear();
-  window.intensity.clear();
-  window.clear.clear();
-  for (auto z = std::int64_t(lo.z()); z <= std::int64_t(hi.z()); ++z) {
-    for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
-      for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
-        const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
-        const double d = (p - s.centre).norm();
-        if (d > reach) continue;
-        double clear = 1;
-        bool theirs = false;
-        for (const HoledSphere* other : near) {
-          if (model_neighbours) {
-            if ((p - other->centre).norm() < other->radius + 4 * other->blur) {
-              clear *= 1 - other->value(p);
-            }
-          } else if ((p - other->centre).norm() < d) {
-            theirs = true;
-            break;
-          }
-        }
-        if (theirs || clear < 1e-3) continue;
-        window.points.push_back(p);
-        window.intensity.push_back(fluid_fraction(stack.at(x, y, z)));
-        if (model_neighbours) window.clear.push_back(clear);
-      }
-    }
-  }
-}
-
-// The voxels within `reach` of `centre`, each with what the neighbours leave clear, 1 -
-// the sum of their grain fractions there (`others`; voxels they cover are left out).
-template <class Others>
-void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
-                  const Others& others, const Eigen::Vector3d& vs, GrainWindow& window) {
+// The voxels within `reach` of `centre` into `window`, each with how much of it the
+// neighbours leave clear, `clear_at(p, d)` (d: p's distance from the centre); voxels left
+// under 1e-3 clear are left out (they say nothing of this grain); the clear shares kept
+// only `with_clear`.
+template <class ClearAt>
+void fill_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
+                 const Eigen::Vector3d& vs, bool with_clear, const ClearAt& clear_at,
+                 GrainWindow& window) {
   const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
   const Eigen::Vector3d lo = ((centre.array() - reach) / vs.array()).ceil().max(0.0);
   const Eigen::Vector3d hi = ((centre.array() + reach) / vs.array()).floor().min(last);
@@ -141,15 +105,48 @@ void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reac
     for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
       for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
         const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
-        if ((p - centre).norm() > reach) continue;
-        const double clear = 1 - others(p);
+        const double d = (p - centre).norm();
+        if (d > reach) continue;
+        const double clear = clear_at(p, d);
         if (clear < 1e-3) continue;
         window.points.push_back(p);
         window.intensity.push_back(fluid_fraction(stack.at(x, y, z)));
-        window.clear.push_back(clear);
+        if (with_clear) window.clear.push_back(clear);
       }
     }
   }
+}
+
+// The voxels within `reach` of grain `s`: with `model_neighbours`, each with how much of it
+// the neighbours leave clear, prod (1 - M_neighbour); without, only the voxels nearer this
+// grain than any neighbour.
+void window_of(const Stack& stack, const HoledSphere& s, double reach,
+               const std::vector<const HoledSphere*>& near, bool model_neighbours,
+               const Eigen::Vector3d& vs, GrainWindow& window) {
+  const auto clear_at = [&](const Eigen::Vector3d& p, double d) {
+    double clear = 1;
+    for (const HoledSphere* other : near) {
+      if (model_neighbours) {
+        if ((p - other->centre).norm() < other->radius + 4 * other->blur) {
+          clear *= 1 - other->value(p);
+        }
+      } else if ((p - other->centre).norm() < d) {
+        return 0.0;  // theirs
+      }
+    }
+    return clear;
+  };
+  fill_window(stack, s.centre, reach, vs, model_neighbours, clear_at, window);
+}
+
+// The voxels within `reach` of `centre`, each with what the neighbours leave clear, 1 -
+// the sum of their grain fractions there (`others`).
+template <class Others>
+void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
+                  const Others& others, const Eigen::Vector3d& vs, GrainWindow& window) {
+  fill_window(
+      stack, centre, reach, vs, true,
+      [&](const Eigen::Vector3d& p, double) { return 1 - others(p); }, window);
 }
 
 }  // namespace
@@ -354,7 +351,7 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
     const Neighbours known = neighbours(true);
     const std::vector<std::size_t>& ids = known.ids;
     const GrainGrid& grid = known.grid;
-    const HoleAxisOptions axis_options;
+    HoleAxisOptions axis_options;
     const std::size_t stride = std::max<std::size_t>(1, ids.size() / 64);
     std::vector<HoleAxisFit> refits(ids.size());
     double across = 0, along_z = 0, shortfall = 0;
@@ -396,12 +393,15 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
         }
       }
       if (round == 1) break;
-      std::vector<double> a, z, r;
+      std::vector<double> a, z, r, b, g;
       for (std::size_t k = 0; k < ids.size(); k += stride) {
         if (!refits[k].converged) continue;
+        const GrainFit& f = grains[ids[k]].fit;
         a.push_back(refits[k].blur_across);
         z.push_back(refits[k].blur_along_z);
-        r.push_back(refits[k].radius - grains[ids[k]].fit.sphere.radius);
+        r.push_back(refits[k].radius - f.sphere.radius);
+        b.push_back(refits[k].fluid - f.fluid);
+        g.push_back(refits[k].grain - f.grain);
       }
       if (a.empty()) break;  // no refit converged: the sample's refits stand
       const auto median = [](std::vector<double>& v) {
@@ -411,6 +411,8 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
       across = median(a);
       along_z = median(z);
       shortfall = median(r);
+      // Every grain's refit starts there: fewer iterations than from the model fit.
+      axis_options.start = {across, along_z, shortfall, median(b), median(g)};
     }
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const HoleAxisFit& r = refits[k];

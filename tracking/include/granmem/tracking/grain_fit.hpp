@@ -9,8 +9,11 @@
 namespace granmem {
 
 // The voxels around one grain: physical positions, normalised intensities (fluid 1,
-// grain 0) and, optionally, how much of each the neighbouring grains leave clear
-// (prod (1 - M_neighbour), 1 where no neighbour reaches).
+// grain 0) and, optionally, how much of each the neighbouring grains leave clear, 1 where
+// no neighbour reaches: for the model fits (fit_grain) prod (1 - M_neighbour), for the
+// axis refit (fit_hole_axis) 1 - sum M_neighbour, their blurred grain fractions added (the
+// blur is linear and the grains do not overlap; the product leaves the overlapping blurred
+// rims of grains stacked along a wide blur too bright and tilted the refit's axes).
 struct GrainWindow {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> intensity;

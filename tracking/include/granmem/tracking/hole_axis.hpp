@@ -17,9 +17,18 @@ namespace granmem {
 Eigen::Vector3d lab_hole_axis(const Stack& normalized, const Eigen::Vector3d& centre, double radius,
                               const Eigen::Vector3d& voxel_size, double within = 0.8);
 
+// Where the refit starts, from the model fit: its blurs (0: the model fit's, alike in every
+// direction) and changes of its radius and levels. locate starts every grain from the
+// medians of a sample's refits: nearer, fewer iterations.
+struct HoleAxisStart {
+  double blur_across = 0, blur_along_z = 0;
+  double radius_change = 0, fluid_change = 0, grain_change = 0;
+};
+
 struct HoleAxisOptions {
   double within = 0.8;  // of the radius: the voxels the axis is fitted to
   int max_iterations = 30;
+  HoleAxisStart start;
 };
 
 struct HoleAxisFit {
@@ -48,10 +57,10 @@ double blurred_grain_fraction(const Eigen::Vector3d& p, const HoledSphere& grain
 // voxel and 1.5x slices, 0.6-1.2 voxel at d = 12, and a noiseless grain's axis then tilts
 // by up to 2 deg away from or towards z). The residuals are those of the image blurred
 // exactly (blurred_grain_fraction: Gauss-Legendre over the blur's offset along the axis
-// between the mouths, the annulus' cross-section blurred by the covariance across it), the
-// Jacobian that of a cheaper model (Jets; the ball exact, the hole an infinite cylinder):
-// a noiseless grain's axis within 0.05 deg of the truth for PSFs 0.5-1.0 voxel across,
-// 0.7-1.5 along z, isotropic or 1.5x slices (bench/axis_single.cpp). Starts from `grain`.
+// between the mouths, the annulus' cross-section blurred by the covariance across it),
+// with its own Jacobian (Jets; ~5 Levenberg-Marquardt iterations): a noiseless grain's
+// axis within 0.05 deg of the truth for PSFs 0.5-1.0 voxel across, 0.7-1.5 along z,
+// isotropic or 1.5x slices (bench/axis_single.cpp). Starts from `grain` and `options.start`.
 HoleAxisFit fit_hole_axis(const GrainWindow& inner, const GrainFit& grain,
                           const HoleAxisOptions& options = {});
 

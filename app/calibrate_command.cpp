@@ -7,6 +7,7 @@
 #include <iostream>
 #include <set>
 #include <sstream>
+#include <thread>
 
 #include "commands.hpp"
 #include "comparison_report.hpp"
@@ -89,10 +90,10 @@ std::string json_text(const std::string& s) {
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
     std::string experiment, out, mu_s = "0.03,0.05,0.08,0.12,0.2,0.3,0.5", window, noise = "auto",
-                                 wall_distance = "0";
+                                 wall_distance = "0", preparation = "each", summaries = "pooled";
     std::map<std::string, std::string> twin;
     bool keep_drift = false;
-    int threads = 0, degree = 2;
+    int threads = 0, degree = 2, replicas = 2;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -120,6 +121,23 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--degree", args->degree,
                   "degree of the polynomial in log mu_s through the runs' summaries")
       ->capture_default_str();
+  cmd->add_option("--replicas", args->replicas,
+                  "packings per friction (seeds seed, seed+1, ...): their scatter is the "
+                  "realization noise the interval includes")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--deposit", args->preparation,
+                  "each: every run pours its seed's grains and deposits them at its own mu_s "
+                  "(as the experiment was prepared); shared: one packing per seed deposited at "
+                  "the twin's --mu-s, its friction switched before the drive")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"each", "shared"}));
+  cmd->add_option("--summaries", args->summaries,
+                  "pooled: the CDF of the window's pooled displacements (the paper's steady "
+                  "state); per-cycle: each cycle's CDF (a transient, e.g. the first cycles after "
+                  "deposition, where friction shows in how the displacements change)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"pooled", "per-cycle"}));
   cmd->add_option("--threads", args->threads, "runs at once (default: all cores)");
   // The twin's settings: as `simulate` takes them, here or in the config's [simulate].
   std::map<std::string, CLI::Option*> given;
@@ -143,10 +161,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       if (option->count() > 0) v[name] = args->twin.at(name);
     }
     const std::vector<double> mu = parse_frictions(args->mu_s);
-    if (mu.size() < std::size_t(args->degree) + 2) {
+    const std::size_t needed = std::size_t(args->degree) + (args->replicas > 1 ? 1 : 2);
+    if (mu.size() < needed) {
       throw Error("--mu-s: " + std::to_string(mu.size()) + " frictions; the fit needs at least " +
-                  std::to_string(args->degree + 2) + " (degree " + std::to_string(args->degree) +
-                  " + 1, and one more to measure the runs' scatter)");
+                  std::to_string(needed) + " (degree " + std::to_string(args->degree) + " + 1" +
+                  (args->replicas > 1 ? "" : ", and one more to measure the runs' scatter") + ")");
     }
     const TrajectoryReader experiment(args->experiment);
     const RunHeader& h = experiment.header();
@@ -184,6 +203,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
 
     FrictionFitOptions fit_options;
     fit_options.degree = args->degree;
+    fit_options.per_cycle = args->summaries == "per-cycle";
     const std::string noise = args->noise == "auto" ? (h.voxel_size ? "fit" : "none") : args->noise;
     if (noise == "fit" || (noise != "none" && !noise.empty())) {
       if (!h.voxel_size) {
@@ -212,34 +232,60 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     series.protocol.drive = drive_from(v, physics, d.box_side, d.box_side, d.lid_mass, d.radius);
     for (const auto& [key, value] : v)
       series.protocol.parameters["simulate/" + key] = value;
+    series.protocol.parameters["calibrate/deposit"] = args->preparation;
     series.protocol.validate(d.box_side, physics.dt);
+    std::vector<std::uint64_t> seeds;
+    for (int r = 0; r < args->replicas; ++r)
+      seeds.push_back(d.seed + std::uint64_t(r));
+    const auto experiment_seed = h.parameters.find("simulate/seed");
+    if (experiment_seed != h.parameters.end() &&
+        std::count(seeds.begin(), seeds.end(), std::stoull(experiment_seed->second))) {
+      std::cerr << "note: the twin's seeds include the experiment's (" << experiment_seed->second
+                << "): one twin run pours the experiment's own grains\n";
+    }
 
     std::cerr << "calibrate: twin of " << args->experiment << ": " << d.grains << " grains, box "
               << d.box_side * 100 << " cm, A = " << series.protocol.drive.amplitude * 100
               << " cm, cycles 1-" << series.protocol.cycles << " (window " << observe.window.first
-              << ":" << observe.window.second << "), mu_s " << args->mu_s << "\n";
-    // One packing for every friction, kept in DIR so that a second call reuses it.
-    const fs::path packing_path = out / "packing.checkpoint.h5";
-    std::optional<Simulation> packing;
-    if (fs::exists(packing_path)) {
-      ProtocolState state;
-      packing.emplace(read_checkpoint(packing_path, &state));
-      if (state.settings != v) {
-        throw Error(packing_path.string() + ": deposited with other settings; remove it or " +
-                    "choose another --out");
+              << ":" << observe.window.second << "), mu_s " << args->mu_s << ", " << args->replicas
+              << " packing(s) from seed " << d.seed << ", deposited "
+              << (args->preparation == "each" ? "at each friction" : "once per seed") << "\n";
+    // Shared packings: one per seed, kept in DIR so that a second call reuses them.
+    std::map<std::uint64_t, Simulation> shared;
+    if (args->preparation == "shared") {
+      for (std::uint64_t seed : seeds) {
+        DepositOptions pour = d;
+        pour.seed = seed;
+        const fs::path path = out / ("packing_seed_" + std::to_string(seed) + ".checkpoint.h5");
+        std::map<std::string, std::string> settings = v;
+        settings["seed"] = std::to_string(seed);
+        if (fs::exists(path)) {
+          ProtocolState state;
+          shared.emplace(seed, read_checkpoint(path, &state));
+          if (state.settings != settings) {
+            throw Error(path.string() + ": deposited with other settings; remove it or " +
+                        "choose another --out");
+          }
+          std::cerr << "reusing the packing of " << path.string() << "\n";
+          continue;
+        }
+        std::cerr << "depositing " << d.grains << " grains (seed " << seed << ")\n";
+        shared.emplace(seed, deposit(pour, physics, nullptr, print_deposit_progress(std::cerr)));
+        ProtocolState state;
+        state.settings = settings;
+        write_checkpoint(path, shared.at(seed), state);
       }
-      std::cerr << "reusing the packing of " << packing_path.string() << "\n";
-    } else {
-      std::cerr << "depositing " << d.grains << " grains (seed " << d.seed << ")\n";
-      packing.emplace(deposit(d, physics, nullptr, print_deposit_progress(std::cerr)));
-      ProtocolState state;
-      state.settings = v;
-      write_checkpoint(packing_path, *packing, state);
     }
+    auto start = [&](const FrictionRunSpec& run) {
+      if (args->preparation == "shared") {
+        return with_sliding_friction(shared.at(run.seed), run.mu_s, series.walls_follow);
+      }
+      return deposit_at_friction(d, physics, run, series.walls_follow);
+    };
 
     // Runs already in DIR with the same settings are reused: a stopped calibration goes on.
-    auto finished = [&](double m) {
-      const fs::path p = friction_run_path(series.dir, m);
+    auto finished = [&](const FrictionRunSpec& run) {
+      const fs::path p = friction_run_path(series.dir, run);
       if (!fs::exists(p)) return false;
       const TrajectoryReader r(p);
       for (const auto& [key, value] : series.protocol.parameters) {
@@ -248,62 +294,78 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       }
       return r.steps().back() >= series.protocol.cycles;
     };
-    auto run_all = [&](const std::vector<double>& frictions) {
-      std::vector<double> todo;
-      for (double m : frictions)
-        if (!finished(m)) todo.push_back(m);
-      if (todo.size() < frictions.size()) {
-        std::cerr << "reusing " << frictions.size() - todo.size() << " finished runs in "
+    auto run_all = [&](const std::vector<FrictionRunSpec>& specs) {
+      std::vector<FrictionRunSpec> todo;
+      for (const FrictionRunSpec& run : specs)
+        if (!finished(run)) todo.push_back(run);
+      if (todo.size() < specs.size()) {
+        std::cerr << "reusing " << specs.size() - todo.size() << " finished runs in "
                   << series.dir.string() << "\n";
       }
       if (todo.empty()) return;
-      run_friction_series(*packing, todo, series, [&](std::size_t k, const CyclicProgress& p) {
-        std::cerr << "mu_s " << todo[k] << ": cycle " << p.cycle << "/" << p.cycles << "  "
-                  << std::scientific << std::setprecision(2) << p.particle_steps_per_second
-                  << std::defaultfloat << std::setprecision(6) << " particle-steps/s  "
-                  << std::llround(p.seconds_left) << " s left\n";
+      std::cerr << todo.size() << " runs, "
+                << (series.parallel > 0 ? series.parallel
+                                        : int(std::thread::hardware_concurrency()))
+                << " at once\n";
+      run_friction_series(todo, series, start, [&](std::size_t k, const CyclicProgress& p) {
+        std::cerr << "mu_s " << todo[k].mu_s << " seed " << todo[k].seed << ": cycle " << p.cycle
+                  << "/" << p.cycles << "  " << std::scientific << std::setprecision(2)
+                  << p.particle_steps_per_second << std::defaultfloat << std::setprecision(6)
+                  << " particle-steps/s  " << std::llround(p.seconds_left) << " s left\n";
       });
     };
-    run_all(mu);
+    std::vector<FrictionRunSpec> specs;
+    for (std::uint64_t seed : seeds)
+      for (double m : mu)
+        specs.push_back({m, seed});
+    run_all(specs);
     std::vector<FrictionRun> runs;
-    for (double m : mu)
+    for (const FrictionRunSpec& run : specs)
       runs.push_back(
-          {m, cycle_observables(TrajectoryReader(friction_run_path(series.dir, m)), observe)});
+          {run.mu_s,
+           cycle_observables(TrajectoryReader(friction_run_path(series.dir, run)), observe),
+           run.seed});
     const FrictionFit fit = fit_friction(measured, runs, fit_options);
 
     // The twin at the fitted friction: what the distances and the figures compare.
     char rounded[32];  // three digits: the run's file name, and a second call finds it
     std::snprintf(rounded, sizeof rounded, "%.3g", fit.mu_s);
     const double best = std::stod(rounded);
-    run_all({best});
-    const fs::path best_path = friction_run_path(series.dir, best);
+    const FrictionRunSpec best_spec{best, d.seed};
+    run_all({best_spec});
+    const fs::path best_path = friction_run_path(series.dir, best_spec);
     const TrajectoryReader best_run(best_path);
     const CycleObservables at_fit = cycle_observables(best_run, observe);
-    const std::size_t simulations = mu.size() + (std::count(mu.begin(), mu.end(), best) ? 0 : 1);
+    const std::size_t simulations = specs.size() + (std::count(mu.begin(), mu.end(), best) ? 0 : 1);
 
     // Tables: the summaries per run, and the figures.
     {
       Table t;
+      Column& cycle = t.add("cycle", "", true);
       Column& level = t.add("threshold_dr", "d");
       Column& exp_cdf = t.add("experiment_cdf");
       Column& exp_err = t.add("experiment_error");
       Column& model = t.add("fit_cdf");
       std::vector<Column*> per_run;
-      for (double m : mu)
-        per_run.push_back(&t.add("cdf_mu_s_" + json_number(m)));
+      for (const FrictionRunSpec& run : specs)
+        per_run.push_back(
+            &t.add("cdf_mu_s_" + json_number(run.mu_s) + "_seed_" + std::to_string(run.seed)));
       for (std::size_t j = 0; j < fit.thresholds.size(); ++j) {
+        cycle.values.push_back(double(fit.threshold_cycle[j]));
         level.values.push_back(fit.thresholds[j]);
         exp_cdf.values.push_back(fit.experiment_cdf[j]);
         exp_err.values.push_back(fit.experiment_error[j]);
         model.values.push_back(fit.model_cdf[j]);
-        for (std::size_t k = 0; k < mu.size(); ++k)
+        for (std::size_t k = 0; k < specs.size(); ++k)
           per_run[k]->values.push_back(fit.run_cdf[k][j]);
       }
       write_csv(t, out / "cdf_summaries.csv",
                 {"smoothed CDF of the end-of-cycle displacement dr (grain diameters) at the "
-                 "experiment's deciles, per simulated mu_s (with the fitted locating noise)"});
+                 "experiment's deciles (of the window, cycle 0, or of each cycle), per simulated "
+                 "mu_s (with the fitted locating noise)"});
       Table r;
       Column& m = r.add("mu_s");
+      Column& seed = r.add("seed", "", true);
       Column& n = r.add("n", "", true);
       Column& mean = r.add("mean_dr", "d");
       Column& median = r.add("median_dr", "d");
@@ -312,6 +374,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
         const CycleObservables& o = k < runs.size() ? runs[k].observables : at_fit;
         const Summary s = summarize(o.dr);
         m.values.push_back(k < runs.size() ? runs[k].mu_s : best);
+        seed.values.push_back(double(k < runs.size() ? specs[k].seed : best_spec.seed));
         n.values.push_back(double(s.count));
         mean.values.push_back(s.mean);
         median.values.push_back(s.median);
@@ -321,7 +384,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                 {"per simulated mu_s (the last row: at the fit): end-of-cycle displacements "
                  "over the window, grain diameters"});
     }
-    std::vector<fs::path> figures = calibration_figures(out, fit, mu);
+    std::vector<double> run_mu;
+    for (const FrictionRunSpec& run : specs)
+      run_mu.push_back(run.mu_s);
+    std::vector<fs::path> figures = calibration_figures(out, fit, run_mu);
     // The distances at the fit: the run at the fitted mu_s with the fitted locating noise.
     const Comparison compared =
         compare_runs(experiment, best_run, "experiment", "DEM mu_s = " + json_number(best), observe,
@@ -341,7 +407,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       j << "{\n  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
         << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
         << "],\n  \"mu_s_interval_method\": " << json_text(fit.method)
-        << ",\n  \"n_simulations\": " << simulations << ",\n  \"mu_s_simulated\": [";
+        << ",\n  \"n_simulations\": " << simulations << ",\n  \"replicas\": " << args->replicas
+        << ",\n  \"deposit\": " << json_text(args->preparation)
+        << ",\n  \"summaries\": " << json_text(args->summaries) << ",\n  \"mu_s_simulated\": [";
       for (std::size_t k = 0; k < mu.size(); ++k)
         j << (k ? ", " : "") << json_number(mu[k]);
       j << "],\n  \"converged\": " << (fit.converged ? "true" : "false")
@@ -372,6 +440,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
               << "  at the fit: KS " << ks << ", Wasserstein-1 " << w1
               << " d (end-of-cycle dr); chi2 " << fit.chi2 << " for " << fit.dof
               << " dof; realization scatter x" << fit.overdispersion << "\n";
+    if (fit.mu_s_ci95[0] < mu.front() || fit.mu_s_ci95[1] > mu.back()) {
+      std::cout << "  the interval reaches beyond the simulated frictions (" << mu.front() << "-"
+                << mu.back() << "): these displacements pin mu_s down only loosely (a larger "
+                << "packing or a longer window would)\n";
+    }
     if (fit.noise_sigma > 0) {
       std::cout << "  locating noise " << fit.noise_sigma << " +- " << fit.noise_sigma_error
                 << " voxel\n";

@@ -183,16 +183,22 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
 std::vector<fs::path> calibration_figures(const fs::path& dir, const FrictionFit& fit,
                                           const std::vector<double>& mu) {
   std::vector<Curve> curves;
-  const double lo = mu.front(), hi = mu.back();
+  const double lo = *std::min_element(mu.begin(), mu.end()),
+               hi = *std::max_element(mu.begin(), mu.end());
   for (std::size_t j : {std::size_t(1), std::size_t(4), std::size_t(7)}) {
     if (j >= fit.thresholds.size()) continue;
     char label[96];
-    std::snprintf(label, sizeof label, "DEM, P(dr < %.3g d)", fit.thresholds[j]);
+    // Per-cycle summaries: these are the first cycle's.
+    const std::string cycle = fit.threshold_cycle.empty() || fit.threshold_cycle[j] == 0
+                                  ? ""
+                                  : ", cycle " + std::to_string(fit.threshold_cycle[j]);
+    std::snprintf(label, sizeof label, "DEM, P(dr < %.3g d%s)", fit.thresholds[j], cycle.c_str());
     Curve runs{label, mu, {}, {}, true};
     for (std::size_t k = 0; k < mu.size(); ++k)
       runs.y.push_back(fit.run_cdf[k][j]);
     curves.push_back(runs);
-    std::snprintf(label, sizeof label, "experiment, P(dr < %.3g d)", fit.thresholds[j]);
+    std::snprintf(label, sizeof label, "experiment, P(dr < %.3g d%s)", fit.thresholds[j],
+                  cycle.c_str());
     curves.push_back({label,
                       {lo, fit.mu_s, hi},
                       {fit.experiment_cdf[j], fit.experiment_cdf[j], fit.experiment_cdf[j]},

@@ -208,14 +208,16 @@ void add_render(CLI::App& app) {
       throw Error("--frame " + std::to_string(args->frame) + ": " + args->run +
                   " has no grain with a position in that frame; nothing to draw");
     }
+    // The truth goes to a temporary file first, and in place only once the scan is written;
+    // both places are checked before the drawing, which takes a while.
+    AtomicFile{args->out};
+    std::optional<AtomicFile> truth_file;
+    if (!args->truth.empty()) truth_file.emplace(args->truth);
     Table truth;
     Stack stack = render_scan(grains, o, &truth);
     stack.source = args->run + " frame " + std::to_string(args->frame);
 
-    // The truth goes to a temporary file first, and in place only once the scan is written.
-    std::optional<AtomicFile> truth_file;
-    if (!args->truth.empty()) {
-      truth_file.emplace(args->truth);
+    if (truth_file) {
       std::ostringstream voxel;
       voxel << std::setprecision(17) << stack.voxel_size->x() << " x " << stack.voxel_size->y()
             << " x " << stack.voxel_size->z() << " " << h.length_unit;

@@ -1,19 +1,50 @@
 #!/usr/bin/env bash
-# The main job on the sample data: install what is needed, build, then import the sample
-# tracked grains and analyse their displacements and rotations; track the sample scans
-# (locate, link) and analyse those too. Output in out/sample/.
+# The main job on the sample data: install what is needed, build, then the whole pipeline.
+#  1. the sample table of tracked grains imported and analysed;
+#  2. a pseudo-experiment: the DEM at a known sliding friction (TRUE_MU_S below), its state
+#     at the end of each cycle drawn as laser-sheet scans (granmem render);
+#  3. the scans tracked (locate, link) and analysed: displacements, single-axis rotations;
+#  4. granmem calibrate: the DEM's friction fitted to the tracked scans, with its interval,
+#     distances and figures;
+#  5. the fitted friction printed next to the true one.
+# Output in out/sample/. Settings in sample_data/sample.toml.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
 granmem=build/app/granmem
+config=sample_data/sample.toml
 out=out/sample
-mkdir -p "$out"
-set -x
-"$granmem" --config sample_data/sample.toml import sample_data/tracked_grains.csv --out "$out/run.h5"
-"$granmem" info "$out/run.h5"
-"$granmem" --config sample_data/sample.toml analyze "$out/run.h5" --out "$out/analysis"
-# The experimental pipeline on the sample scans: locate and link, then analyse the tracks.
-"$granmem" track sample_data/scans/scan*.tif --diameter 5mm --out "$out/tracks.h5" \
-  --detections "$out/detections"
-"$granmem" analyze "$out/tracks.h5" --out "$out/tracks_analysis"
+TRUE_MU_S=0.15
+rm -rf "$out/scans" "$out/calibration"
+mkdir -p "$out/scans"
+SECONDS=0
+step() { echo "== [${SECONDS} s] $*" >&2; }
+
+step "1/5 the sample table of tracked grains"
+"$granmem" --config $config import sample_data/tracked_grains.csv --out "$out/run.h5"
+"$granmem" --config $config analyze "$out/run.h5" --out "$out/analysis"
+
+step "2/5 pseudo-experiment: DEM at mu_s = $TRUE_MU_S (seed 101), scans of each cycle's end"
+"$granmem" --config $config simulate --mu-s $TRUE_MU_S --seed 101 --out "$out/experiment_dem.h5"
+for cycle in 0 1 2; do
+  "$granmem" --config $config render "$out/experiment_dem.h5" --frame $cycle \
+    --seed $((cycle + 1)) --out "$out/scans/scan$cycle.tif" --truth "$out/scans/truth$cycle.csv"
+done
+
+step "3/5 tracking the scans (locate, link) and analysing the tracks"
+"$granmem" track "$out"/scans/scan*.tif --diameter 5mm --out "$out/tracks.h5" \
+  --analyze "$out/tracks_analysis"
+
+step "4/5 calibrating the DEM's friction on the tracked scans"
+"$granmem" --config $config calibrate --experiment "$out/tracks.h5" --out "$out/calibration" \
+  | tee "$out/calibration.txt"
+
+step "5/5 result"
+summary="$out/calibration/summary.json"
+fitted=$(sed -n 's/^  "mu_s": \(.*\),$/\1/p' "$summary")
+interval=$(sed -n 's/^  "mu_s_ci95": \[\(.*\)\],$/\1/p' "$summary")
+echo "sliding friction: fitted $fitted (95% interval $interval), true $TRUE_MU_S" \
+  | tee "$out/result.txt"
+echo "figures and tables in $out/calibration/ (pdf_displacement.png, calibration.png, ...)"
+step "done"

@@ -105,6 +105,7 @@ CycleObservables cycle_observables(const TrajectoryReader& run, const Observable
         displacement.push_back(m.displacement.row(Eigen::Index(k)).transpose() * to_d);
         o.dr.push_back(dr);
         o.dr_grain.push_back(m.grain[k]);
+        o.dr_cycle.push_back(steps[t]);
         if (std::isfinite(rot)) {
           o.rot_disp.push_back(rot);
           o.rot_grain.push_back(m.grain[k]);

@@ -20,20 +20,48 @@ double normal_cdf(double x) {
   return 0.5 * std::erfc(-x * M_SQRT1_2);
 }
 
-// A sample's smoothed CDF at the thresholds, kept as sums per grain so that whole grains
-// can be resampled: F_j = sum_g S_gj / sum_g n_g.
-struct GrainSums {
-  Eigen::MatrixXd sum;    // grains x thresholds
-  Eigen::VectorXd count;  // values per grain
-  Eigen::VectorXd cdf() const { return sum.colwise().sum().transpose() / count.sum(); }
+// The summaries: thresholds of log(dr) for each group of displacements (one group pooling
+// the window, or one per cycle), `levels` per group.
+struct SummaryLevels {
+  std::vector<double> tau;          // groups x levels, log(dr)
+  std::vector<std::int64_t> cycle;  // per group: its cycle, or 0 for the pooled window
+  Eigen::Index levels = 0;
+  // The group of a displacement of cycle `c`, or -1 when none holds it.
+  Eigen::Index group(std::int64_t c) const {
+    if (cycle.size() == 1 && cycle[0] == 0) return 0;
+    const auto it = std::find(cycle.begin(), cycle.end(), c);
+    return it == cycle.end() ? -1 : Eigen::Index(it - cycle.begin());
+  }
+  Eigen::Index size() const { return Eigen::Index(tau.size()); }
 };
 
-// Adds log(value) of grain `grain` (compact index) to the sums.
-void add_value(GrainSums& s, std::size_t grain, double log_value, const std::vector<double>& tau,
-               double width) {
-  for (std::size_t j = 0; j < tau.size(); ++j)
-    s.sum(Eigen::Index(grain), Eigen::Index(j)) += normal_cdf((tau[j] - log_value) / width);
-  s.count(Eigen::Index(grain)) += 1;
+// A sample's smoothed CDFs at the thresholds, kept as sums per grain so that whole grains
+// can be resampled: F_j = sum_g S_gj / sum_g n_g,group(j).
+struct GrainSums {
+  Eigen::MatrixXd sum;    // grains x summaries
+  Eigen::MatrixXd count;  // grains x groups: values per grain in each group
+  Eigen::Index levels = 1;
+  GrainSums(std::size_t grains, const SummaryLevels& l)
+      : sum(Eigen::MatrixXd::Zero(Eigen::Index(grains), l.size())),
+        count(Eigen::MatrixXd::Zero(Eigen::Index(grains), Eigen::Index(l.cycle.size()))),
+        levels(l.levels) {}
+  // The CDFs of grains weighted by `weight` (ones: the sample itself).
+  Eigen::VectorXd cdf(const Eigen::VectorXd& weight) const {
+    const Eigen::RowVectorXd s = weight.transpose() * sum, n = weight.transpose() * count;
+    Eigen::VectorXd f(s.size());
+    for (Eigen::Index j = 0; j < s.size(); ++j)
+      f(j) = s(j) / n(j / levels);
+    return f;
+  }
+  Eigen::VectorXd cdf() const { return cdf(Eigen::VectorXd::Ones(sum.rows())); }
+};
+
+// Adds log(value) of grain `grain` (compact index) in group `group` to the sums.
+void add_value(GrainSums& s, std::size_t grain, Eigen::Index group, double log_value,
+               const SummaryLevels& l, double width) {
+  for (Eigen::Index j = group * l.levels; j < (group + 1) * l.levels; ++j)
+    s.sum(Eigen::Index(grain), j) += normal_cdf((l.tau[std::size_t(j)] - log_value) / width);
+  s.count(Eigen::Index(grain), group) += 1;
 }
 
 // Compact grain indices 0..G-1 for the grain labels of a sample.
@@ -55,7 +83,7 @@ Eigen::MatrixXd bootstrap_covariance(const GrainSums& s, std::size_t resamples, 
     weight.setZero();
     for (Eigen::Index k = 0; k < g; ++k)
       weight(Eigen::Index(random.uniform() * double(g))) += 1;
-    f.row(Eigen::Index(b)) = (weight.transpose() * s.sum) / weight.dot(s.count);
+    f.row(Eigen::Index(b)) = s.cdf(weight).transpose();
   }
   const Eigen::MatrixXd centred = f.rowwise() - f.colwise().mean();
   return centred.transpose() * centred / double(resamples - 1);
@@ -65,7 +93,7 @@ Eigen::MatrixXd bootstrap_covariance(const GrainSums& s, std::size_t resamples, 
 // log(mu_s) across the runs.
 class SimulatedSummaries {
  public:
-  SimulatedSummaries(const std::vector<FrictionRun>& runs, const std::vector<double>& tau,
+  SimulatedSummaries(const std::vector<FrictionRun>& runs, const SummaryLevels& tau,
                      const FrictionFitOptions& o)
       : runs_(runs), tau_(tau), o_(o) {
     Random random(o.seed + 1);
@@ -91,19 +119,24 @@ class SimulatedSummaries {
     const CycleObservables& o = runs_[k].observables;
     std::size_t grains = 0;
     const std::vector<std::size_t> g = compact(o.dr_grain, &grains);
-    GrainSums s{Eigen::MatrixXd::Zero(Eigen::Index(grains), Eigen::Index(tau_.size())),
-                Eigen::VectorXd::Zero(Eigen::Index(grains))};
+    GrainSums s(grains, tau_);
     const Eigen::MatrixXd& z = normals_[k];
     const Eigen::Index n = o.displacement.rows();
     const Eigen::Index copies = z.rows() / std::max<Eigen::Index>(n, 1);
     const Eigen::RowVector3d scale = M_SQRT2 * sigma * o_.noise_shape.transpose();
     for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Index group = tau_.group(o.dr_cycle.empty() ? 0 : o.dr_cycle[std::size_t(i)]);
+      if (group < 0) continue;
       for (Eigen::Index c = 0; c < copies; ++c) {
         const Eigen::RowVector3d d =
             o.displacement.row(i) + scale.cwiseProduct(z.row(i * copies + c));
         const double dr = d.norm();
-        if (dr > 0) add_value(s, g[std::size_t(i)], std::log(dr), tau_, o_.kernel_width);
+        if (dr > 0) add_value(s, g[std::size_t(i)], group, std::log(dr), tau_, o_.kernel_width);
       }
+    }
+    if ((s.count.colwise().sum().array() == 0).any()) {
+      throw Error("friction fit: the run at mu_s " + std::to_string(runs_[k].mu_s) +
+                  " has no displacement in a cycle the experiment has");
     }
     return s;
   }
@@ -111,7 +144,7 @@ class SimulatedSummaries {
   // Runs x thresholds, cached for the last sigma (Ceres varies one parameter at a time).
   const Eigen::MatrixXd& run_cdfs(double sigma) const {
     if (sigma != cached_sigma_ || cached_.size() == 0) {
-      cached_.resize(Eigen::Index(runs_.size()), Eigen::Index(tau_.size()));
+      cached_.resize(Eigen::Index(runs_.size()), tau_.size());
       for (std::size_t k = 0; k < runs_.size(); ++k)
         cached_.row(Eigen::Index(k)) = run_sums(k, sigma).cdf().transpose();
       cached_sigma_ = sigma;
@@ -152,7 +185,7 @@ class SimulatedSummaries {
   }
 
   const std::vector<FrictionRun>& runs_;
-  const std::vector<double>& tau_;
+  const SummaryLevels& tau_;
   const FrictionFitOptions& o_;
   std::vector<Eigen::MatrixXd> normals_;
   double centre_ = 0;
@@ -172,6 +205,16 @@ struct SummaryResidual {
     return true;
   }
 };
+
+// The 97.5 % point of Student's t with `dof` degrees of freedom (Cornish-Fisher expansion
+// about the normal's 1.96; within 0.2 % for dof >= 3): the interval's multiplier when the
+// realization noise is itself estimated from a few spare runs.
+double t_975(double dof) {
+  const double z = 1.959964, z3 = z * z * z, z5 = z3 * z * z;
+  if (!(dof > 0) || !std::isfinite(dof)) return z;
+  return z + (z3 + z) / (4 * dof) + (5 * z5 + 16 * z3 + 3 * z) / (96 * dof * dof) +
+         (3 * z5 * z * z + 19 * z5 + 17 * z3 - 15 * z) / (384 * dof * dof * dof);
+}
 
 std::string format_number(double x) {
   char text[32];
@@ -225,29 +268,38 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   if (o.probabilities.empty()) throw Error("friction fit: no CDF levels");
 
   // The experiment's summaries and their sampling covariance.
+  // Groups: the pooled window, or each cycle of it.
+  std::map<std::int64_t, std::vector<double>> by_cycle;
   std::vector<double> log_dr;
   std::vector<std::size_t> grain_of;
+  std::vector<std::int64_t> cycle_of;
   for (std::size_t k = 0; k < experiment.dr.size(); ++k) {
     if (experiment.dr[k] > 0 && std::isfinite(experiment.dr[k])) {
       log_dr.push_back(std::log(experiment.dr[k]));
       grain_of.push_back(experiment.dr_grain[k]);
+      cycle_of.push_back(o.per_cycle && !experiment.dr_cycle.empty() ? experiment.dr_cycle[k] : 0);
+      by_cycle[cycle_of.back()].push_back(log_dr.back());
     }
   }
-  if (log_dr.size() < 10 * o.probabilities.size()) {
-    throw Error("friction fit: " + std::to_string(log_dr.size()) +
-                " measured displacements, too few for " + std::to_string(o.probabilities.size()) +
-                " CDF levels");
+  SummaryLevels tau;
+  tau.levels = Eigen::Index(o.probabilities.size());
+  for (const auto& [c, values] : by_cycle) {
+    if (values.size() < 10 * o.probabilities.size()) {
+      throw Error("friction fit: " + std::to_string(values.size()) + " measured displacements" +
+                  (c ? " in cycle " + std::to_string(c) : std::string()) + ", too few for " +
+                  std::to_string(o.probabilities.size()) + " CDF levels");
+    }
+    tau.cycle.push_back(c);
+    for (double p : o.probabilities)
+      tau.tau.push_back(quantile(values, p));
   }
-  std::vector<double> tau;
-  for (double p : o.probabilities)
-    tau.push_back(quantile(log_dr, p));
-  const Eigen::Index nj = Eigen::Index(tau.size());
+  if (by_cycle.empty()) throw Error("friction fit: no measured displacement");
+  const Eigen::Index nj = tau.size();
   std::size_t grains = 0;
   const std::vector<std::size_t> g = compact(grain_of, &grains);
-  GrainSums exp_sums{Eigen::MatrixXd::Zero(Eigen::Index(grains), nj),
-                     Eigen::VectorXd::Zero(Eigen::Index(grains))};
+  GrainSums exp_sums(grains, tau);
   for (std::size_t k = 0; k < log_dr.size(); ++k)
-    add_value(exp_sums, g[k], log_dr[k], tau, o.kernel_width);
+    add_value(exp_sums, g[k], tau.group(cycle_of[k]), log_dr[k], tau, o.kernel_width);
   const Eigen::VectorXd target = exp_sums.cdf();
   Random random(o.seed);
   const Eigen::MatrixXd exp_cov = bootstrap_covariance(exp_sums, o.bootstrap, random);
@@ -287,6 +339,7 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   FrictionFit fit;
   ceres::Problem::Options po;
   Eigen::MatrixXd run_cov;
+  double estimated_share = 0;  // of the summaries' variance, the part from the runs' scatter
   // Two rounds: the simulation's covariance depends on the noise and, through the
   // polynomial's leverage, on mu_s; both are taken at the previous round's fit.
   for (int round = 0; round < 2; ++round) {
@@ -307,7 +360,9 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
                eigen.eigenvectors().transpose();
       fit.overdispersion = std::max(1.0, residual.trace() / run_cov.trace());
     }
-    Eigen::MatrixXd cov = exp_cov + excess + model.leverage(log_mu) * (run_cov + excess);
+    const double leverage = model.leverage(log_mu);
+    Eigen::MatrixXd cov = exp_cov + excess + leverage * (run_cov + excess);
+    estimated_share = (1 + leverage) * excess.trace() / cov.trace();
     cov.diagonal().array() += 1e-12;
     const Eigen::MatrixXd whitening = cov.llt().matrixL().solve(Eigen::MatrixXd::Identity(nj, nj));
 
@@ -351,12 +406,58 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
     }
   }
   fit.mu_s = std::exp(log_mu);
-  fit.mu_s_ci95 = {std::exp(log_mu - 1.96 * fit.log_mu_s_sigma),
-                   std::exp(log_mu + 1.96 * fit.log_mu_s_sigma)};
+  // The realization noise is estimated from the runs' spare degrees of freedom, the
+  // bootstrap's part is known well: Satterthwaite's effective dof of their sum sets
+  // Student's multiplier (few spare runs and a large realization share: a wider interval).
+  const double spare = double(runs.size()) - double(o.degree + 1);
+  const double effective_dof =
+      estimated_share > 0 && spare > 0 ? spare / (estimated_share * estimated_share) : 0.0;
+  double t = t_975(effective_dof);
+  // Cross-validation across packings: the summaries' covariance, estimated from a few spare
+  // runs, cannot see every direction in which one packing differs from another; fitting
+  // twin runs of known friction with the other seeds' runs measures how far a realization
+  // moves the fitted mu_s. The interval takes the larger of the two errors.
+  if (o.cross_validate) {
+    FrictionFitOptions inner = o;
+    inner.cross_validate = false;
+    inner.noise = NoiseModel::none;  // simulated against simulated: no locating noise
+    double sum2 = 0;
+    for (const FrictionRun& held_out : runs) {
+      const double m = std::log(held_out.mu_s);
+      std::vector<FrictionRun> others;
+      double others_lo = std::numeric_limits<double>::infinity(), others_hi = -others_lo;
+      for (const FrictionRun& r : runs) {
+        if (r.seed == held_out.seed) continue;
+        others.push_back(r);
+        others_lo = std::min(others_lo, std::log(r.mu_s));
+        others_hi = std::max(others_hi, std::log(r.mu_s));
+      }
+      // Interior frictions only: at the range's ends the bounded fit cannot err outwards.
+      if (others.size() < std::size_t(o.degree) + 1 || !(others_lo < m && m < others_hi)) continue;
+      try {
+        const FrictionFit f = fit_friction(held_out.observables, others, inner);
+        sum2 += std::pow(std::log(f.mu_s) - m, 2);
+        ++fit.cross_validations;
+      } catch (const Error&) {
+        // too few distinct frictions among the others: no test from this run
+      }
+    }
+    if (fit.cross_validations > 0) {
+      fit.cross_validated_sigma = std::sqrt(sum2 / double(fit.cross_validations));
+      if (fit.cross_validated_sigma > fit.log_mu_s_sigma) {
+        fit.log_mu_s_sigma = fit.cross_validated_sigma;
+        t = t_975(double(fit.cross_validations));
+      }
+    }
+  }
+  fit.mu_s_ci95 = {std::exp(log_mu - t * fit.log_mu_s_sigma),
+                   std::exp(log_mu + t * fit.log_mu_s_sigma)};
   fit.noise_sigma = sigma;
   fit.simulations = runs.size();
-  for (double t : tau)
-    fit.thresholds.push_back(std::exp(t));
+  for (Eigen::Index j = 0; j < nj; ++j) {
+    fit.thresholds.push_back(std::exp(tau.tau[std::size_t(j)]));
+    fit.threshold_cycle.push_back(tau.cycle[std::size_t(j / tau.levels)]);
+  }
   const Eigen::VectorXd at_fit = model.predict(log_mu, sigma);
   for (Eigen::Index j = 0; j < nj; ++j) {
     fit.experiment_cdf.push_back(target(j));
@@ -370,13 +471,26 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   }
   fit.method =
       "Ceres generalized least squares on the smoothed CDF of log(dr) at the experiment's " +
-      std::to_string(nj) +
-      " quantiles, covariance from a bootstrap over grains of the experiment and of the "
+      std::to_string(tau.levels) + " quantiles" +
+      (o.per_cycle ? " of each of its " + std::to_string(tau.cycle.size()) + " cycles"
+                   : std::string(" of the pooled window")) +
+      ", covariance from a bootstrap over grains of the experiment and of the "
       "runs plus the realization noise measured on the runs' scatter about the fit across "
       "frictions (x" +
-      format_number(fit.overdispersion) +
-      " the sampling variance); 95 % interval from Ceres' covariance of ln(mu_s)" +
+      format_number(fit.overdispersion) + " the sampling variance, from " + format_number(spare) +
+      " spare runs)" + "; 95 % interval from Ceres' covariance of ln(mu_s)" +
+      (effective_dof > 0 ? ", Student's t with " + format_number(effective_dof) + " effective dof"
+                         : std::string()) +
       std::string(fit.error_scale > 1 ? ", widened by sqrt(chi2/dof)" : "") +
+      (fit.cross_validations > 0
+           ? "; cross-validated across packings (" + std::to_string(fit.cross_validations) +
+                 " twin runs of known mu_s fitted with the other seeds' runs: RMS error " +
+                 format_number(fit.cross_validated_sigma) + " in ln mu_s" +
+                 (fit.cross_validated_sigma >= fit.log_mu_s_sigma
+                      ? ", which sets the interval, Student's t with " +
+                            std::to_string(fit.cross_validations) + " dof)"
+                      : ", within Ceres' error)")
+           : std::string()) +
       (fit_noise ? "; locating noise fitted jointly" : "");
   return fit;
 }

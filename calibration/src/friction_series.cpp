@@ -12,49 +12,64 @@
 
 namespace granmem {
 
-Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool walls_follow) {
-  PhysicsOptions physics = packing.physics();
+PhysicsOptions with_sliding_friction(PhysicsOptions physics, double mu_s, bool walls_follow) {
   physics.contact.mu_s = mu_s;
   if (walls_follow) physics.wall.mu_s = mu_s;
-  Simulation sim(packing.grains(), packing.container(), physics);
+  return physics;
+}
+
+Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool walls_follow) {
+  Simulation sim(packing.grains(), packing.container(),
+                 with_sliding_friction(packing.physics(), mu_s, walls_follow));
   sim.restore(packing.time(), packing.step_count(), packing.pair_histories(),
               packing.wall_histories(), packing.wall_loads());
   return sim;
 }
 
-std::filesystem::path friction_run_path(const std::filesystem::path& dir, double mu_s) {
-  char name[64];
-  std::snprintf(name, sizeof name, "mu_s_%.4g.h5", mu_s);
+Simulation deposit_at_friction(DepositOptions deposit, const PhysicsOptions& physics,
+                               const FrictionRunSpec& run, bool walls_follow) {
+  deposit.seed = run.seed;
+  return granmem::deposit(deposit, with_sliding_friction(physics, run.mu_s, walls_follow));
+}
+
+std::filesystem::path friction_run_path(const std::filesystem::path& dir,
+                                        const FrictionRunSpec& run) {
+  char name[96];
+  std::snprintf(name, sizeof name, "mu_s_%.4g_seed_%llu.h5", run.mu_s,
+                static_cast<unsigned long long>(run.seed));
   return dir / name;
 }
 
 std::vector<std::filesystem::path> run_friction_series(
-    const Simulation& packing, const std::vector<double>& mu_s,
-    const FrictionSeriesOptions& options,
+    const std::vector<FrictionRunSpec>& runs, const FrictionSeriesOptions& options,
+    const std::function<Simulation(const FrictionRunSpec&)>& start,
     const std::function<void(std::size_t, const CyclicProgress&)>& progress) {
-  if (mu_s.empty()) throw Error("friction series: no mu_s values");
-  for (double m : mu_s) {
-    if (!(m > 0 && std::isfinite(m))) throw Error("friction series: mu_s must be positive");
+  if (runs.empty()) throw Error("friction series: no mu_s values");
+  for (const FrictionRunSpec& r : runs) {
+    if (!(r.mu_s > 0 && std::isfinite(r.mu_s))) {
+      throw Error("friction series: mu_s must be positive");
+    }
   }
   std::vector<std::filesystem::path> out;
-  for (double m : mu_s)
-    out.push_back(friction_run_path(options.dir, m));
+  for (const FrictionRunSpec& r : runs)
+    out.push_back(friction_run_path(options.dir, r));
   const int workers =
-      std::max(1, std::min<int>(int(mu_s.size()), options.parallel > 0
+      std::max(1, std::min<int>(int(runs.size()), options.parallel > 0
                                                       ? options.parallel
                                                       : int(std::thread::hardware_concurrency())));
   std::atomic<std::size_t> next{0};
   std::mutex report;
   std::exception_ptr failure;
   auto work = [&] {
-    for (std::size_t k; (k = next++) < mu_s.size();) {
+    for (std::size_t k; (k = next++) < runs.size();) {
       try {
-        Simulation sim = with_sliding_friction(packing, mu_s[k], options.walls_follow);
+        Simulation sim = start(runs[k]);
         sim.set_threads(1);  // parallel over runs: one thread each
         CyclicOptions c = options.protocol;
         c.out = out[k];
         c.checkpoint.clear();
-        c.parameters["calibrate/mu_s"] = std::to_string(mu_s[k]);
+        c.parameters["calibrate/mu_s"] = std::to_string(runs[k].mu_s);
+        c.parameters["calibrate/seed"] = std::to_string(runs[k].seed);
         ProtocolState state;
         run_cycles(sim, c, state, [&](const CyclicProgress& p) {
           if (!progress) return;
@@ -64,7 +79,7 @@ std::vector<std::filesystem::path> run_friction_series(
       } catch (...) {
         const std::lock_guard<std::mutex> lock(report);
         if (!failure) failure = std::current_exception();
-        next = mu_s.size();
+        next = runs.size();
       }
     }
   };

@@ -17,7 +17,8 @@ class Calibrate : public GranmemTest {
  protected:
   void SetUp() override {
     GranmemTest::SetUp();
-    std::vector<std::string> sim{"simulate", "--cycles", "3",      "--seed",    "2", "--mu-s",
+    // Another pour than the twin's seeds (1, 2): another realization of the packing.
+    std::vector<std::string> sim{"simulate", "--cycles", "3",      "--seed",    "7", "--mu-s",
                                  "0.2",      "--out",    "exp.h5", "--threads", "1"};
     sim.insert(sim.end(), kTwin.begin(), kTwin.end());
     granmem_ok(sim);
@@ -48,11 +49,12 @@ TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
   std::stringstream text;
   text << in.rdbuf();
   const std::string json = text.str();
-  for (const char* key : {"\"mu_s\"", "\"mu_s_ci95\"", "\"n_simulations\": 5", "ks_dr",
-                          "wasserstein1_dr", "\"settings\""}) {
+  for (const char* key : {"\"mu_s\"", "\"mu_s_ci95\"", "\"n_simulations\": 9", "\"replicas\": 2",
+                          "ks_dr", "wasserstein1_dr", "\"settings\""}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
   }
-  // mu_s lies inside its interval, and inside the simulated range.
+  // mu_s lies inside its interval, and inside the simulated range; the true 0.2 inside the
+  // interval, made from the twin's scatter across its two packings.
   double mu = 0, lo = 0, hi = 0;
   std::sscanf(json.substr(json.find("\"mu_s\":")).c_str(), "\"mu_s\": %lf", &mu);
   std::sscanf(json.substr(json.find("\"mu_s_ci95\":")).c_str(), "\"mu_s_ci95\": [%lf, %lf]", &lo,
@@ -61,6 +63,9 @@ TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
   EXPECT_LE(mu, hi);
   EXPECT_GE(mu, 0.05);
   EXPECT_LE(mu, 0.4);
+  EXPECT_LE(lo, 0.2);
+  EXPECT_GE(hi, 0.2);
+  EXPECT_NE(json.find("cross-validated across packings"), std::string::npos) << json;
   for (const char* f :
        {"cal/pdf_displacement.png", "cal/pdf_displacement.svg", "cal/field_translation.png",
         "cal/calibration.png", "cal/runs.csv", "cal/distances.csv", "cal/pdf_rotation_axes.png"}) {

@@ -182,6 +182,9 @@ TEST_F(RenderTest, BadInputSaysWhatAndWritesNothing) {
   expect_clean_failure(with({"--frame", "1", "--no-artefacts", "--blur", "1"}), "--blur");
   expect_clean_failure({"render", "run.h5", "--out", "x.tif"}, "--frame");
   expect_clean_failure({"render", "missing.h5", "--frame", "0", "--out", "x.tif"}, "missing.h5");
+  expect_clean_failure(
+      {"render", "run.h5", "--frame", "1", "--out", "x.tif", "--truth", "no/x.csv"},
+      "folder 'no' does not exist");
 }
 
 }  // namespace

@@ -38,6 +38,7 @@ struct CycleObservables {
   Vectors3 displacement;
   std::vector<double> dr;
   std::vector<std::size_t> dr_grain;
+  std::vector<std::int64_t> dr_cycle;  // the cycle c of each (displacement c-1 -> c)
   // Single-axis rotational displacements (angle between the cavity axes times d/2),
   // pooled likewise; empty when not asked for.
   std::vector<double> rot_disp;

@@ -15,6 +15,7 @@ namespace granmem {
 struct FrictionRun {
   double mu_s = 0;
   CycleObservables observables;
+  std::uint64_t seed = 1;  // of the packing: runs of other seeds are other realizations
 };
 
 // How the locating error of a scan is put into the simulated displacements before they are
@@ -38,9 +39,17 @@ struct FrictionFitOptions {
   double noise_sigma = 0;          // the value (fixed) or ignored (fitted)
   std::size_t noise_replicas = 4;  // noisy copies of each simulated displacement
   std::uint64_t seed = 1;          // of the bootstrap and the noise: fixed draws
+  // Summaries of each cycle's distribution rather than of the window's pooled one: in a
+  // transient (the first cycles after deposition) the displacements change from cycle to
+  // cycle, and how they change depends on the friction.
+  bool per_cycle = false;
   // The simulated summaries across the runs as a polynomial in log(mu_s) of this degree
   // (at most the number of runs - 1).
   int degree = 2;
+  // With runs of two seeds or more: each run at an interior friction, taken as the
+  // experiment, is fitted with the other seeds' runs; the spread of the fitted ln(mu_s)
+  // about the run's own is the realization's part of the error, measured where it matters.
+  bool cross_validate = true;
 };
 
 struct FrictionFit {
@@ -55,14 +64,19 @@ struct FrictionFit {
   // traces): the realization noise of a packing, added to the experiment's errors and the
   // runs'.
   double overdispersion = 1;
+  // Cross-validation across packings: RMS of ln(fitted / true mu_s) over the held-out runs
+  // (0 when not made), and how many.
+  double cross_validated_sigma = 0;
+  std::size_t cross_validations = 0;
   bool converged = false;
   std::size_t simulations = 0;
-  std::vector<double> thresholds;            // dr at the summaries, diameters
-  std::vector<double> experiment_cdf;        // F_exp at the thresholds
-  std::vector<double> experiment_error;      // bootstrap standard errors
-  std::vector<double> model_cdf;             // simulated F at the fit
-  std::vector<std::vector<double>> run_cdf;  // per run (with the fitted noise)
-  std::string method;                        // how the interval was obtained, in words
+  std::vector<double> thresholds;             // dr at the summaries, diameters
+  std::vector<std::int64_t> threshold_cycle;  // the cycle of each summary (0: pooled window)
+  std::vector<double> experiment_cdf;         // F_exp at the thresholds
+  std::vector<double> experiment_error;       // bootstrap standard errors
+  std::vector<double> model_cdf;              // simulated F at the fit
+  std::vector<std::vector<double>> run_cdf;   // per run (with the fitted noise)
+  std::string method;                         // how the interval was obtained, in words
 };
 
 // Fits mu_s (and the locating noise, when fitted) so that the simulated end-of-cycle

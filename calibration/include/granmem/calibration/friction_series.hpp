@@ -1,37 +1,55 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <vector>
 
 #include "granmem/sim/cyclic_protocol.hpp"
+#include "granmem/sim/deposit.hpp"
 #include "granmem/sim/simulation.hpp"
 
 namespace granmem {
 
-// The simulated twin of an experiment run at several sliding frictions: the same deposited
-// packing (positions, contact springs) and the same protocol for each, so that only the
-// friction differs between the runs.
+// One run of the simulated twin: its sliding friction and the seed of its packing (runs of
+// one seed pour the same grains; other seeds are other realizations of the packing).
+struct FrictionRunSpec {
+  double mu_s = 0;
+  std::uint64_t seed = 1;
+};
+
+// The simulated twin of an experiment run at several sliding frictions and seeds, under the
+// same protocol, so that only the friction (and, between seeds, the realization) differs.
 struct FrictionSeriesOptions {
   CyclicOptions protocol;     // drive and cycles (its out and checkpoint are not used)
-  std::filesystem::path dir;  // run k goes to dir/mu_s_<value>.h5
+  std::filesystem::path dir;  // run k goes to friction_run_path(dir, mu_s, seed)
   bool walls_follow = true;   // the walls' and lid's sliding friction is the grains'
   int parallel = 0;           // runs at once, one thread each; 0: all cores
 };
 
-// The packing with another sliding friction between grains (and on the walls with
-// `walls_follow`), every contact's history kept.
+// The physics with another sliding friction between grains (and on the walls with
+// `walls_follow`).
+PhysicsOptions with_sliding_friction(PhysicsOptions physics, double mu_s, bool walls_follow);
+
+// The packing with another sliding friction, every contact's history kept.
 Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool walls_follow);
 
-// Runs the protocol from `packing` for each mu_s, independent runs in parallel; returns
-// the end-of-cycle stores written, in the order of `mu_s`. `progress(k, p)` is called
-// (from the run's thread, one call at a time) as run k completes cycles.
+// The grains of `run.seed` poured and deposited at the run's friction: the experiment's
+// packing was prepared with its own friction, which sets how loose it is.
+Simulation deposit_at_friction(DepositOptions deposit, const PhysicsOptions& physics,
+                               const FrictionRunSpec& run, bool walls_follow);
+
+// Runs the protocol for each spec from the packing `start(spec)` (called in the run's
+// thread), independent runs in parallel; returns the end-of-cycle stores written, in the
+// order of `runs`. `progress(k, p)` is called (from the run's thread, one call at a time)
+// as run k completes cycles.
 std::vector<std::filesystem::path> run_friction_series(
-    const Simulation& packing, const std::vector<double>& mu_s,
-    const FrictionSeriesOptions& options,
+    const std::vector<FrictionRunSpec>& runs, const FrictionSeriesOptions& options,
+    const std::function<Simulation(const FrictionRunSpec&)>& start,
     const std::function<void(std::size_t, const CyclicProgress&)>& progress = {});
 
-std::filesystem::path friction_run_path(const std::filesystem::path& dir, double mu_s);
+std::filesystem::path friction_run_path(const std::filesystem::path& dir,
+                                        const FrictionRunSpec& run);
 
 }  // namespace granmem

@@ -9,6 +9,7 @@
 //
 //   axis_bench [--grains N] [--phi F] [--diameters 8,12,16] [--z-ratios 1,1.5] [--bits 8]
 //              [--psf 0.7,0.7,1.0] [--threads T] [--seed S] [--out axis_bench.csv]
+//              [--clean]     (no noise, flicker, streaks or fall-off)
 //              [--dump grains.csv]   (per grain of the first scan: true and fitted axes...)
 //
 // Prints locate's time per grain (all grains, wall clock) on stderr.
@@ -59,9 +60,11 @@ int main(int argc, char** argv) {
     const std::vector<double> p = bench::number_list(v);
     if (p.size() == 3) psf = Eigen::Vector3d(p[0], p[1], p[2]);
   };
-  std::string dump;  // per grain: truth, found, axes, errors
+  bool clean = false;  // no noise, flicker, streaks or fall-off: what is left is the method's
+  std::string dump;    // per grain: truth, found, axes, errors
   setters["--dump"] = [&](const std::string& v) { dump = v; };
-  const bool parsed = bench::parse_options(argc, argv, "axis_bench", setters);
+  const bool parsed =
+      bench::parse_options(argc, argv, "axis_bench", setters, {{"--clean", [&] { clean = true; }}});
   if (!parsed) return 2;
   omp_set_num_threads(o.threads);
   std::ofstream csv(o.out);
@@ -87,6 +90,10 @@ int main(int argc, char** argv) {
       for (double b : o.bits) {
         scan.options.bits = int(b);
         scan.options.blur_sigma = psf;
+        if (clean) {
+          scan.options.read_noise = scan.options.gain = scan.options.flicker = 0;
+          scan.options.attenuation = scan.options.streaks_per_slice = 0;
+        }
         Table truth;
         Stack stack = render_scan(scan.grains, scan.options, &truth);
         LocateOptions lo;

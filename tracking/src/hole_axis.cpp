@@ -92,10 +92,6 @@ ceres::Jet<double, N> annulus(const ceres::Jet<double, N>& p1, const ceres::Jet<
                                       d_out * out_iso.v + d_rh * rh_iso.v);
 }
 
-double normal_cdf(double u) {
-  return 0.5 * std::erfc(-u * M_SQRT1_2);
-}
-
 // sqrt(v + tiny): the same number for plain numbers, a finite slope for Jets at 0.
 template <class T>
 T soft_sqrt(const T& v) {
@@ -170,46 +166,6 @@ struct BlurredGrain {
     }
     return m;
   }
-
-  // Cheaper, for the neighbours (points outside the grain): the ball exactly (the
-  // in-plane disk of radius sqrt(R^2 - z'^2) integrated over the offset z' along z), less
-  // the hole's plug as an infinite cylinder (blurred by the covariance across the axis)
-  // times its axial extent.
-  double outside_value(const V& d) const {
-    const Rules& q = rules();
-    const double rho = std::hypot(d.x(), d.y()) / across;
-    const double lo = std::max(-q.reach, (-R - d.z()) / along_z);
-    const double hi = std::min(q.reach, (R - d.z()) / along_z);
-    double ball = 0;
-    if (lo < hi) {
-      const double mid = 0.5 * (lo + hi), half = 0.5 * (hi - lo);
-      for (int i = 0; i < q.n; ++i) {
-        const double zeta = mid + half * q.legendre.x[std::size_t(i)];
-        const double z = d.z() + along_z * zeta;
-        ball += half * q.legendre.w[std::size_t(i)] * 0.3989422804014327 *
-                std::exp(-0.5 * zeta * zeta) *
-                blurred_disk(rho, std::sqrt(std::max(R * R - z * z, 0.0)) / across).value;
-      }
-    }
-    const double t = d.dot(a);
-    const V across_axis = d - t * a;
-    // The plug's cross-section: blurred by v_u + shift^2 along u, v_w across.
-    const double vu = iso * iso + (u_wider ? excess * excess : 0) + shift * shift;
-    const double vw = across * across;
-    const double iso2 = std::sqrt(std::min(vu, vw)), excess2 = std::sqrt(std::abs(vu - vw));
-    const double q1 = across_axis.dot(u), q2 = across_axis.dot(w);
-    double cylinder = 0;
-    for (int g = 0; g < q.k; ++g) {
-      const double e = excess2 * q.hermite.x[std::size_t(g)];
-      const double x1 = vu > vw ? q1 + e : q1, x2 = vu > vw ? q2 : q2 + e;
-      cylinder +=
-          q.hermite.w[std::size_t(g)] * blurred_disk(std::hypot(x1, x2) / iso2, rh / iso2).value;
-    }
-    // The plug's ends, flat at its mean length.
-    const double h2 = (rh / R) * (rh / R);
-    const double end = R * 2 / (3 * h2) * (1 - std::pow(1 - h2, 1.5));
-    return ball - cylinder * (normal_cdf((end - t) / sigma_t) - normal_cdf((-end - t) / sigma_t));
-  }
 };
 
 // The fit's parameters: log blur across (x, y), log blur along z, fluid and grain levels,
@@ -261,10 +217,10 @@ struct InnerHoleResiduals {
 }  // namespace
 
 double blurred_grain_fraction(const Eigen::Vector3d& p, const HoledSphere& grain,
-                              double blur_across, double blur_along_z, bool outside) {
+                              double blur_across, double blur_along_z) {
   const BlurredGrain<double> model(grain.axis.normalized(), blur_across, blur_along_z, grain.radius,
                                    grain.hole);
-  return outside ? model.outside_value(p - grain.centre) : model.value(p - grain.centre);
+  return model.value(p - grain.centre);
 }
 
 HoleAxisFit fit_hole_axis(const GrainWindow& inner, const GrainFit& grain,

@@ -40,11 +40,12 @@ struct HoleAxisFit {
 };
 
 // The grain fraction of `grain` at p seen through a Gaussian blur of widths `blur_across`
-// (x, y) and `blur_along_z` (z), exact to quadrature (the image fit_hole_axis fits). With
-// `outside`, cheaper, for points outside the grain (a neighbour's): the ball exact, the
-// hole's plug with flat ends and its blur along the axis apart from that across it.
+// (x, y) and `blur_along_z` (z), exact to quadrature (the image fit_hole_axis fits; locate
+// sees each grain's neighbours so: with a cheaper one, the hole's plug with flat ends, a
+// noiseless packing's axes were 0.46 / 1.19 deg (median / p95) against 0.43 / 0.99 at PSF
+// 1.0 / 1.0 / 1.5 voxel, 1.5x slices, and locate no faster).
 double blurred_grain_fraction(const Eigen::Vector3d& p, const HoledSphere& grain,
-                              double blur_across, double blur_along_z, bool outside = false);
+                              double blur_across, double blur_along_z);
 
 // The hole's axis refitted on the grain's inner voxels (within `within` x its radius of
 // the fitted centre; `inner` as GrainWindow, `clear` optional: 1 - the neighbours' summed

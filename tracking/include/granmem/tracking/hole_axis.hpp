@@ -26,7 +26,9 @@ struct HoleAxisStart {
 };
 
 struct HoleAxisOptions {
-  double within = 0.8;  // of the radius: the voxels the axis is fitted to
+  // Of the radius: the voxels the axis is fitted to (locate: the model fit's radius plus
+  // the sample's median shortfall, the refit's).
+  double within = 0.8;
   int max_iterations = 30;
   HoleAxisStart start;
 };

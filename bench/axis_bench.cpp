@@ -41,13 +41,6 @@ using namespace granmem::testing;
 
 constexpr double kDegree = 3.14159265358979323846 / 180;
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
-  const std::size_t k = std::min(v.size() - 1, std::size_t(q * double(v.size())));
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
-  return v[k];
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {

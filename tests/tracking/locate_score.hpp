@@ -62,6 +62,14 @@ inline PackingScan packing_scan(std::size_t n, double phi, double diameter_px, d
   return s;
 }
 
+// The q-quantile of v (the value at rank floor(q n), clamped to the last); NaN when empty.
+inline double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  const std::size_t k = std::min(v.size() - 1, std::size_t(q * double(v.size())));
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+  return v[k];
+}
+
 // How well a set of detections matches the truth of a rendered scan. Errors in voxels of
 // each axis (z in slices).
 struct LocateScore {
@@ -85,13 +93,7 @@ struct LocateScore {
 
   double interior_fraction() const { return interior ? double(interior_found) / interior : 1.0; }
   double spurious_fraction() const { return grains ? double(spurious) / grains : 0.0; }
-  double axis_percentile(double q) const {
-    if (axis_degrees.empty()) return NAN;
-    std::vector<double> a = axis_degrees;
-    const std::size_t k = std::min(a.size() - 1, std::size_t(q * double(a.size())));
-    std::nth_element(a.begin(), a.begin() + std::ptrdiff_t(k), a.end());
-    return a[k];
-  }
+  double axis_percentile(double q) const { return percentile(axis_degrees, q); }
 };
 
 // Asymptotic Kolmogorov distribution: P(sqrt(n) D > t).

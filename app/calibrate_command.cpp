@@ -50,8 +50,9 @@ std::vector<double> parse_frictions(const std::string& text) {
 // used, and they must agree with the twin's.
 void check_against_experiment(const RunHeader& experiment, const std::string& file,
                               const std::map<std::string, std::string>& twin, double box) {
-  for (const char* key : {"grains", "box", "diameter", "amplitude", "drive", "wall-motion",
-                          "lid-mass", "period", "inertial-number", "polydispersity"}) {
+  for (const char* key :
+       {"grains", "box", "diameter", "amplitude", "drive", "wall-motion", "lid-mass",
+        "lid-pressure", "period", "inertial-number", "polydispersity"}) {
     const auto it = experiment.parameters.find(std::string("simulate/") + key);
     if (it != experiment.parameters.end() && it->second != twin.at(key)) {
       throw Error(file + ": the experiment was simulated with --" + key + " " + it->second +

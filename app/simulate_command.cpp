@@ -15,6 +15,7 @@
 #include "granmem/core/units.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
 #include "granmem/sim/deposit.hpp"
+#include "granmem/sim/quasi_static.hpp"
 #include "simulation_settings.hpp"
 
 namespace granmem::app {
@@ -124,6 +125,9 @@ SimulateSettings add_simulate(CLI::App& app) {
       for (std::size_t k = 0; k < kPackingOptionCount; ++k) {
         const char* name = kPackingOptions[k];
         const auto it = trained.settings.find(name);
+        if (it == trained.settings.end() && std::string(name) == "lid-pressure") {
+          continue;  // written before the option existed: its lid mass is explicit
+        }
         if (it == trained.settings.end()) {
           throw Error(*start_from + ": has no setting '" + name +
                       "' (was it written by granmem simulate?)");
@@ -203,7 +207,12 @@ SimulateSettings add_simulate(CLI::App& app) {
       DepositSummary s;
       sim.emplace(deposit(d, physics, &s, print_deposit_progress(std::cerr)));
       std::cerr << "settled: packing fraction " << s.packing_fraction << ", lid at "
-                << s.lid_height * 100 << " cm, " << s.contacts_per_grain << " contacts per grain\n";
+                << s.lid_height * 100 << " cm";
+      if (d.lid_mass > 0) {
+        std::cerr << " (" << d.lid_mass * 1e3 << " g, "
+                  << lid_pressure(d.lid_mass, physics.gravity, d.box_side, d.box_side) << " Pa)";
+      }
+      std::cerr << ", " << s.contacts_per_grain << " contacts per grain\n";
       state.settings = v;
     }
     sim->set_threads(*threads);  // 0: by the number of grains

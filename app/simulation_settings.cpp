@@ -5,8 +5,13 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
+#include "granmem/sim/quasi_static.hpp"
 
 namespace granmem::app {
+
+namespace {
+constexpr const char* kPaperLidPressureText = "436Pa";  // kPaperLidPressure, as given
+}  // namespace
 
 const OptionSpec kSimulateOptions[] = {
     {"grains", "2000", "number of grains"},
@@ -20,7 +25,10 @@ const OptionSpec kSimulateOptions[] = {
     {"diameter", "0.5cm", "grain diameter"},
     {"polydispersity", "0", "radii uniform in r(1 +- p)"},
     {"density", "1.18g/cm^3", "grain density"},
-    {"lid-mass", "1kg", "mass of the free lid (0: no lid)"},
+    {"lid-pressure", kPaperLidPressureText,
+     "pressure of the free lid on the packing (436Pa: the paper's 1 kg on 15 x 15 cm; 0: no "
+     "lid)"},
+    {"lid-mass", "auto", "mass of the free lid (auto: from --lid-pressure; 0: no lid)"},
     {"k-n", "4e6g/s^2", "normal spring constant"},
     {"restitution-n", "0.2", "normal restitution coefficient"},
     {"restitution-t", "0.5", "tangential restitution coefficient"},
@@ -53,6 +61,7 @@ const char* const kPackingOptions[] = {"grains",
                                        "polydispersity",
                                        "density",
                                        "lid-mass",
+                                       "lid-pressure",
                                        "k-n",
                                        "restitution-n",
                                        "restitution-t",
@@ -117,13 +126,28 @@ PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
   return p;
 }
 
+double lid_mass_from(const std::map<std::string, std::string>& v, double box, double gravity) {
+  if (v.at("lid-mass") != "auto") {
+    if (v.at("lid-pressure") != kPaperLidPressureText) {
+      throw Error("--lid-mass " + v.at("lid-mass") + " and --lid-pressure " + v.at("lid-pressure") +
+                  ": give the lid's mass or its pressure, not both");
+    }
+    return si(v, "lid-mass", Dimension::mass);
+  }
+  const double pressure = si(v, "lid-pressure", Dimension::pressure);
+  if (!(pressure >= 0)) {
+    throw Error("--lid-pressure '" + v.at("lid-pressure") + "': must be zero or positive");
+  }
+  return lid_mass_for_pressure(pressure, gravity, box, box);
+}
+
 DepositOptions deposit_from(const std::map<std::string, std::string>& v) {
   DepositOptions d;
   d.grains = whole(v, "grains");
   d.radius = 0.5 * si(v, "diameter", Dimension::length);
   d.polydispersity = number(v, "polydispersity");
   d.box_side = si(v, "box", Dimension::length);
-  d.lid_mass = si(v, "lid-mass", Dimension::mass);
+  d.lid_mass = lid_mass_from(v, d.box_side, si(v, "gravity", Dimension::acceleration));
   d.seed = std::uint64_t(whole(v, "seed"));
   d.settled_energy = si(v, "settled-energy", Dimension::energy);
   d.settling_damping = number(v, "settling-damping");
@@ -150,14 +174,10 @@ WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsO
     if (!(number(v, "inertial-number") > 0)) {
       throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
     }
-    // Under the lid the confining pressure is its weight over the box; the lateral stress
-    // just beneath it, about half that, is the smallest in the packing. Without a lid, the
-    // weight of one layer of grains.
-    const double pressure = lid_mass > 0 ? lid_mass * physics.gravity / (box * box)
-                                         : physics.density * 0.6 * physics.gravity * 2 * radius;
-    const double speed = quasi_static_wall_speed(number(v, "inertial-number"), box_y, 2 * radius,
-                                                 0.5 * pressure, physics.density);
-    d.period = WallDrive::period_for_speed(d.amplitude, speed, d.symmetry, d.shape);
+    const double stress = confining_stress(lid_pressure(lid_mass, physics.gravity, box, box),
+                                           physics.density, physics.gravity, 2 * radius);
+    d.period = quasi_static_period(number(v, "inertial-number"), d, box_y, 2 * radius, stress,
+                                   physics.density);
   } else {
     d.period = si(v, "period", Dimension::time);
   }

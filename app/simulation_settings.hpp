@@ -48,6 +48,9 @@ std::int64_t whole(const std::map<std::string, std::string>& v, const std::strin
 bool yes_no(const std::map<std::string, std::string>& v, const std::string& name);
 
 PhysicsOptions physics_from(const std::map<std::string, std::string>& v);
+// The lid's mass: --lid-mass, or (auto) the mass that presses with --lid-pressure on a
+// square box of side `box`.
+double lid_mass_from(const std::map<std::string, std::string>& v, double box, double gravity);
 // The deposition (grains, box, lid, seed, settling); checks the sizes.
 DepositOptions deposit_from(const std::map<std::string, std::string>& v);
 // The wall's drive in a box of depth `box_y` along y and side `box` (the lid's pressure);

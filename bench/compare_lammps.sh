@@ -5,7 +5,8 @@
 #   bench/compare_lammps.sh            N = 2,000 (L = 7 cm): a few minutes
 #   bench/compare_lammps.sh --full     also N = 20,000 (L = 15 cm): ~15 min on a quiet machine
 #
-# Options: --full; --sizes "2000 20000"; --steps N (timed steps, default 20000 for
+# Options: --full; --native (also time a build for this machine's processor,
+# -DGRANMEM_NATIVE=ON, in <build>-native); --sizes "2000 20000"; --steps N (timed steps, default 20000 for
 # N <= 5000 and 5000 above); --seed S (1); --settle-threads T (granmem threads and LAMMPS
 # ranks for settling, 2); --limit SECONDS (each settle and timed run is stopped after this
 # long; default none); --out DIR (out/compare_lammps); --build DIR (build-bench-lmp);
@@ -30,9 +31,11 @@ out="$root/out/compare_lammps"
 build="$root/build-bench-lmp"
 skip_build=0
 reuse=0
+native=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) sizes="2000 20000" ;;
+    --native) native=1 ;;
     --sizes) sizes="$2"; shift ;;
     --steps) steps="$2"; shift ;;
     --seed) seed="$2"; shift ;;
@@ -42,7 +45,7 @@ while [[ $# -gt 0 ]]; do
     --build) build="$2"; shift ;;
     --skip-build) skip_build=1 ;;
     --reuse) reuse=1 ;;
-    -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "compare_lammps.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -68,6 +71,12 @@ if [[ $skip_build -eq 0 ]]; then
     > "$out/cmake.log" 2>&1
   cmake --build "$build" -j2 --target dem_bench >> "$out/cmake.log" 2>&1 ||
     { tail -30 "$out/cmake.log" >&2; exit 1; }
+  if [[ $native -eq 1 ]]; then
+    cmake -S "$root" -B "$build-native" -DGRANMEM_BUILD_BENCH=ON -DGRANMEM_BUILD_TESTS=OFF \
+      -DGRANMEM_NATIVE=ON >> "$out/cmake.log" 2>&1
+    cmake --build "$build-native" -j2 --target dem_bench >> "$out/cmake.log" 2>&1 ||
+      { tail -30 "$out/cmake.log" >&2; exit 1; }
+  fi
 fi
 bench="$build/bench/dem_bench"
 lammps_dir="$root/bench/lammps"
@@ -149,12 +158,17 @@ for n in $sizes; do
   say "timed: $nsteps steps, y = 0 wall 0 -> A -> 0 (cosine), A = 1% of L"
   say "                           particle-steps/s   peak RSS (MiB)   lid after (cm)"
   declare -A rate=()
-  for t in 1 2; do
-    log="$out/$tag.time_granmem_t$t.log"
-    run_limited /usr/bin/time -v "$bench" time "$out/$tag.settled.h5" "$nsteps" "$t" > "$log" 2>&1 || true
-    rate[g$t]=$(grep "^granmem time:" "$log" | field particle_steps_per_s)
-    printf "  granmem, %d thread%s        %10.3g        %8s         %s\n" "$t" "$([[ $t -gt 1 ]] && echo s || echo ' ')" \
-      "${rate[g$t]:-nan}" "$(rss_max "$log")" "$(grep "^granmem time:" "$log" | field lid_cm_after)" | tee -a "$summary"
+  builds=("g:$bench:granmem")
+  [[ $native -eq 1 ]] && builds+=("n:$build-native/bench/dem_bench:native ")
+  for b in "${builds[@]}"; do
+    IFS=: read -r key binary label <<< "$b"
+    for t in 1 2; do
+      log="$out/$tag.time_${label// /}_t$t.log"
+      run_limited /usr/bin/time -v "$binary" time "$out/$tag.settled.h5" "$nsteps" "$t" > "$log" 2>&1 || true
+      rate[$key$t]=$(grep "^granmem time:" "$log" | field particle_steps_per_s)
+      printf "  %s, %d thread%s        %10.3g        %8s         %s\n" "$label" "$t" "$([[ $t -gt 1 ]] && echo s || echo ' ')" \
+        "${rate[$key$t]:-nan}" "$(rss_max "$log")" "$(grep "^granmem time:" "$log" | field lid_cm_after)" | tee -a "$summary"
+    done
   done
   for p in 1 2; do
     log="$out/$tag.time_lammps_np$p.log"
@@ -167,9 +181,12 @@ for n in $sizes; do
     printf "  LAMMPS, %d rank%s           %10.3g        %-16s %s\n" "$p" "$([[ $p -gt 1 ]] && echo s || echo ' ')" \
       "${rate[l$p]}" "$mem" "$(grep "^LAMMPS time:" "$log" | field lid_cm_after)" | tee -a "$summary"
   done
-  for t in 1 2; do
-    ratio=$(awk -v a="${rate[g$t]:-0}" -v b="${rate[l$t]:-0}" 'BEGIN { if (a > 0 && b > 0) printf "%.2f", a / b; else print "n/a" }')
-    say "  granmem/LAMMPS at $t thread$([[ $t -gt 1 ]] && echo s)/rank$([[ $t -gt 1 ]] && echo s): $ratio"
+  for b in "${builds[@]}"; do
+    IFS=: read -r key binary label <<< "$b"
+    for t in 1 2; do
+      ratio=$(awk -v a="${rate[$key$t]:-0}" -v b="${rate[l$t]:-0}" 'BEGIN { if (a > 0 && b > 0) printf "%.2f", a / b; else print "n/a" }')
+      say "  ${label// /}/LAMMPS at $t thread$([[ $t -gt 1 ]] && echo s)/rank$([[ $t -gt 1 ]] && echo s): $ratio"
+    done
   done
   spc=$(grep -h "^granmem time:" "$out/$tag.time_granmem_t"*.log | head -1 | field steps_per_cycle_paper)
   best=$(awk -v a="${rate[g1]:-0}" -v b="${rate[g2]:-0}" 'BEGIN { print (a > b ? a : b) }')

@@ -30,6 +30,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/deposit.hpp"
+#include "granmem/sim/quasi_static.hpp"
 #include "granmem/sim/simulation.hpp"
 #include "granmem/sim/wall_drive.hpp"
 
@@ -76,7 +77,8 @@ granmem::DepositOptions deposit_options(long grains, double box_cm, long seed) {
   d.grains = grains;
   d.box_side = box_cm * kCm;
   d.seed = std::uint64_t(seed);
-  d.lid_mass = 1.0 * (d.box_side * d.box_side) / (kPaperBox * kPaperBox);
+  d.lid_mass = granmem::lid_mass_for_pressure(
+      granmem::kPaperLidPressure, granmem::PhysicsOptions{}.gravity, d.box_side, d.box_side);
   return d;
 }
 
@@ -172,18 +174,18 @@ int export_data(const std::vector<std::string>& a) {
 }
 
 // Steps per cycle of the paper's protocol as `granmem simulate` sets it by default
-// (--period auto: a cosine drive of A = 0.15 cm at inertial number 1e-3 under half the
-// pressure of a 1 kg lid on 15 x 15 cm; the formula of app/simulate_command.cpp), with this
-// packing's grains and time step.
-double paper_steps_per_cycle(const Simulation& sim) {
+// (--period auto: a cosine drive of A = 1 % of the 15 cm box at inertial number 1e-3
+// under the paper's lid pressure), with this packing's grains and time step.
+double paper_steps_per_cycle(const Simulation& sim, double inertial_number = 1e-3) {
   const auto& p = sim.physics();
-  const double diameter = 2 * sim.grains().radius.at(0), amplitude = 0.01 * kPaperBox;
-  const double lid_pressure = 1.0 * p.gravity / (kPaperBox * kPaperBox);
-  const double speed =
-      granmem::quasi_static_wall_speed(1e-3, kPaperBox, diameter, 0.5 * lid_pressure, p.density);
-  const double period = granmem::WallDrive::period_for_speed(
-      amplitude, speed, granmem::DriveSymmetry::asymmetric, granmem::DriveShape::cosine);
-  return std::round(period / p.dt);
+  const double diameter = 2 * sim.grains().radius.at(0);
+  granmem::WallDrive drive;
+  drive.amplitude = 0.01 * kPaperBox;
+  const double stress =
+      granmem::confining_stress(granmem::kPaperLidPressure, p.density, p.gravity, diameter);
+  return std::round(
+      granmem::quasi_static_period(inertial_number, drive, kPaperBox, diameter, stress, p.density) /
+      p.dt);
 }
 
 int time_run(const std::vector<std::string>& a) {

@@ -102,6 +102,10 @@ constexpr SiUnit kSiUnits[] = {
     {Dimension::velocity, "mm/s", 1e-3},
     {Dimension::energy, "J", 1.0},
     {Dimension::energy, "erg", 1e-7},
+    {Dimension::pressure, "Pa", 1.0},
+    {Dimension::pressure, "kPa", 1e3},
+    {Dimension::pressure, "N/m^2", 1.0},
+    {Dimension::pressure, "dyn/cm^2", 0.1},
 };
 
 }  // namespace

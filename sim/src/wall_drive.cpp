@@ -41,11 +41,6 @@ double WallDrive::period_for_speed(double amplitude, double speed, DriveSymmetry
   return shape == DriveShape::cosine ? M_PI * amplitude / speed : 2 * amplitude / speed;
 }
 
-double quasi_static_wall_speed(double inertial_number, double box_length, double diameter,
-                               double pressure, double density) {
-  return inertial_number * box_length * std::sqrt(pressure / density) / diameter;
-}
-
 DriveSymmetry parse_drive_symmetry(const std::string& text) {
   if (text == "asymmetric") return DriveSymmetry::asymmetric;
   if (text == "symmetric") return DriveSymmetry::symmetric;

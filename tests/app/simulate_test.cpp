@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "granmem/core/trajectory_store.hpp"
+#include "granmem/sim/checkpoint.hpp"
 #include "run_granmem.hpp"
 
 namespace granmem::testing {
@@ -50,6 +51,39 @@ TEST_F(GranmemTest, SimulateWritesFramesTheAnalysisReads) {
     EXPECT_GT(dr, 0);
   // Simulated runs have orientations: the full rotation comes too.
   EXPECT_TRUE(fs::exists(in_work("a") / "pdf_theta_full_deg.csv"));
+}
+
+// The lid presses with the paper's 436 Pa (1 kg on 15 x 15 cm) in any box, unless told
+// otherwise as a pressure or as a mass (not both); the quasi-static period follows the
+// pressure as 1 / sqrt(P).
+TEST_F(GranmemTest, SimulateLidPressesWithThePapersPressureInAnyBox) {
+  auto lid_mass = [&](const std::string& checkpoint) {
+    return read_checkpoint(in_work(checkpoint)).container().lid.mass;
+  };
+  const double area = 0.02 * 0.02, g = 9.81;
+  const RunResult paper = granmem_ok(with(kTiny, {"--cycles", "1", "--out", "paper.h5"}));
+  EXPECT_NEAR(lid_mass("paper.checkpoint.h5") * g / area, 436.0, 1e-9);
+  EXPECT_NE(paper.err.find("436 Pa"), std::string::npos) << paper.err;
+  granmem_ok(with(kTiny, {"--cycles", "1", "--lid-pressure", "1.5kPa", "--out", "p.h5"}));
+  EXPECT_NEAR(lid_mass("p.checkpoint.h5") * g / area, 1500.0, 1e-9);
+  granmem_ok(with(kTiny, {"--cycles", "1", "--lid-mass", "30g", "--out", "m.h5"}));
+  EXPECT_NEAR(lid_mass("m.checkpoint.h5"), 0.03, 1e-15);
+  const RunResult both =
+      granmem(with(kTiny, {"--lid-mass", "30g", "--lid-pressure", "1.5kPa", "--out", "b.h5"}));
+  EXPECT_NE(both.exit_code, 0);
+  EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
+  EXPECT_FALSE(fs::exists(in_work("b.h5")));
+
+  // The period for I = 1e-3 (5 mm grains, 1 % of the box): the paper's 0.365454 s at its
+  // pressure, half that at 4x the pressure.
+  auto period = [&](const std::string& pressure) {
+    const RunResult r = granmem_ok({"simulate", "--grains", "60", "--box", "2cm", "--cycles", "1",
+                                    "--lid-pressure", pressure, "--out", pressure + ".h5"});
+    const auto at = r.err.find("period ");
+    return at == std::string::npos ? -1.0 : std::stod(r.err.substr(at + 7));
+  };
+  EXPECT_NEAR(period("436Pa"), 0.365454, 1e-6);
+  EXPECT_NEAR(period("1744Pa"), 0.365454 / 2, 1e-6);
 }
 
 TEST_F(GranmemTest, SimulateResumedGivesTheSameRun) {

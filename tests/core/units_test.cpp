@@ -39,3 +39,17 @@ TEST(Units, LengthConversions) {
 
 }  // namespace
 }  // namespace granmem
+
+namespace granmem {
+namespace {
+
+TEST(Units, PressuresInSi) {
+  EXPECT_DOUBLE_EQ(parse_si("436Pa", Dimension::pressure, "", "p"), 436);
+  EXPECT_DOUBLE_EQ(parse_si("0.436 kPa", Dimension::pressure, "", "p"), 436);
+  EXPECT_DOUBLE_EQ(parse_si("4360dyn/cm^2", Dimension::pressure, "", "p"), 436);
+  EXPECT_THROW(parse_si("436", Dimension::pressure, "", "p"), Error);     // needs a unit
+  EXPECT_THROW(parse_si("436 kg", Dimension::pressure, "", "p"), Error);  // not a pressure
+}
+
+}  // namespace
+}  // namespace granmem

@@ -33,7 +33,17 @@ double metres_per(std::string_view unit);
 double convert_length(double value, std::string_view from, std::string_view to);
 
 // What a configuration value measures; each accepts a few units, turned into SI.
-enum class Dimension { length, time, mass, density, stiffness, acceleration, velocity, energy };
+enum class Dimension {
+  length,
+  time,
+  mass,
+  density,
+  stiffness,
+  acceleration,
+  velocity,
+  energy,
+  pressure
+};
 
 // "4e6 g/s^2" -> 4000 (N/m). Without a unit, `default_unit` is assumed; with neither,
 // or with a unit of another dimension, throws Error naming `what` and the units accepted.

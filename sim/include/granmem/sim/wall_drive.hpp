@@ -27,12 +27,6 @@ struct WallDrive {
                                  DriveShape shape);
 };
 
-// The quasi-static limit: the inertial number I = (strain rate) d / sqrt(P / rho) of a
-// packing of grain diameter d and density rho under pressure P, sheared at strain rate
-// (wall speed / box length). Returns the wall speed that gives `inertial_number`.
-double quasi_static_wall_speed(double inertial_number, double box_length, double diameter,
-                               double pressure, double density);
-
 DriveSymmetry parse_drive_symmetry(const std::string& text);
 DriveShape parse_drive_shape(const std::string& text);
 

@@ -55,7 +55,7 @@ compare() {  # a.h5 b.h5 folder
     "$granmem" compare "$1" "$2" --window "$window" --wall-distance "$diameter" --out "$3" > "$3.log" 2>&1
 }
 
-names=$(for f in "$runs"/*.done; do [[ -e $f ]] && basename "$f" .done; done)
+names=$(for f in "$runs"/*.done; do if [[ -e $f ]]; then basename "$f" .done; fi; done)
 [[ -n $names ]] || { echo "quasistatic_report.sh: no finished runs in $runs" >&2; exit 1; }
 
 per_cycle="$out/per_cycle.csv"
@@ -81,7 +81,10 @@ echo "# steady state over cycles $window: means of the end-of-cycle translationa
 echo "mu_s,seed,inertial_number,mean_dr_d,mean_rot_disp_d,packing_fraction,wall_force_full_compression_N,ks_dr_vs_slowest,ks_p_dr_vs_slowest,ks_rot_vs_slowest,ks_p_rot_vs_slowest,ks_dr_seed1_vs_seed2,ks_rot_seed1_vs_seed2" >> "$steady"
 for name in $names; do
   read -r mu seed inertial <<< "$(parse "$name")"
-  slowest=$(for n in $names; do read -r m s i <<< "$(parse "$n")"; [[ $m == "$mu" && $s == "$seed" ]] && echo "$i $n"; done | sort -g | head -1 | cut -d' ' -f2)
+  slowest=$(for n in $names; do
+    read -r m s i <<< "$(parse "$n")"
+    if [[ $m == "$mu" && $s == "$seed" ]]; then echo "$i $n"; fi
+  done | sort -g | head -1 | cut -d' ' -f2)
   compare "$runs/$slowest.h5" "$runs/$name.h5" "$work/vs_slowest_$name"
   read -r _ dr _ _ <<< "$(distance_row "$work/vs_slowest_$name/distances.csv" 1)"
   read -r _ rot _ _ <<< "$(distance_row "$work/vs_slowest_$name/distances.csv" 2)"
@@ -104,21 +107,27 @@ done
 sort -t, -k1,1g -k2,2n -k3,3g -o "$steady.body" <(grep -v "^#\|^mu_s" "$steady")
 { grep "^#\|^mu_s" "$steady"; cat "$steady.body"; } > "$steady.tmp" && mv "$steady.tmp" "$steady" && rm "$steady.body"
 
-# The figure: per-cycle mean displacement and rotation for each drive (one panel per
-# friction), and the steady state against the inertial number.
+# The figure: per-cycle means for each drive (one panel per friction; lines seed 1, points
+# seed 2), and the steady state against the inertial number.
+inertials=$(grep -v "^#\|^mu_s" "$steady" | cut -d, -f3 | sort -gu | tr '\n' ',' | sed 's/,$//')
+frictions=$(grep -v "^#\|^mu_s" "$steady" | cut -d, -f1 | sort -gu | tr '\n' ',' | sed 's/,$//')
 gnuplot <<EOF
-set terminal pngcairo size 1400,1000 font ",11"
+set terminal pngcairo size 1400,1400 font ",11"
 set output "$out/quasistatic.png"
 set datafile separator ","
-set multiplot layout 2,2 title "Quasi-static limit: 1,500 grains, 5 cm box, 436 Pa, A = 1 %; lines: seed 1, points: seed 2"
+set termoption noenhanced
+array I[$(echo "$inertials" | tr ',' '\n' | wc -l)] = [$inertials]
+array M[$(echo "$frictions" | tr ',' '\n' | wc -l)] = [$frictions]
+is(x, y) = abs(x / y - 1) < 1e-9
+set multiplot layout 3,2 title "Quasi-static limit: 1,500 grains, 5 cm box, lid 436 Pa, A = 1 % (drift removed, grains > 1 d from the walls)"
 set key top right
 set xlabel "cycle"
 set logscale y
-do for [mu in "0.05 0.5"] {
-  set title sprintf("mu_s = %s: per-cycle mean end-of-cycle displacement", mu)
+do for [m = 1:|M|] {
+  set title sprintf("mu_s = %g: per-cycle mean end-of-cycle displacement (lines seed 1, points seed 2)", M[m])
   set ylabel "mean dr (grain diameters)"
-  plot for [i in "3e-4 1e-3 3e-3 1e-2"] "$per_cycle" using (\$1 == mu+0 && \$2 == 1 && \$3 == i+0 ? \$4 : 1/0):5 with lines lw 2 title sprintf("I = %s", i), \
-       for [i in "3e-4 1e-3 3e-3 1e-2"] "$per_cycle" using (\$1 == mu+0 && \$2 == 2 && \$3 == i+0 ? \$4 : 1/0):5 with points pt 7 ps 0.5 notitle
+  plot for [k = 1:|I|] "$per_cycle" using ((is(\$1, M[m]) && \$2 == 1 && is(\$3, I[k])) ? \$4 : NaN):5 with lines lw 2 lc k title sprintf("I = %g", I[k]), \
+       for [k = 1:|I|] "$per_cycle" using ((is(\$1, M[m]) && \$2 == 2 && is(\$3, I[k])) ? \$4 : NaN):5 with points pt 7 ps 0.4 lc k notitle
 }
 unset logscale y
 set logscale x
@@ -126,10 +135,16 @@ set xlabel "inertial number I"
 set key top left
 set title "steady state (cycles $window): mean end-of-cycle displacement"
 set ylabel "mean dr (grain diameters)"
-plot for [mu in "0.05 0.5"] for [s in "1 2"] "$steady" using (\$1 == mu+0 && \$2 == s+0 ? \$3 : 1/0):4 with linespoints lw 2 pt 7 title sprintf("mu_s %s, seed %s", mu, s)
-set title "steady state (cycles $window): mean rotational displacement (angle x radius)"
+plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):4 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+set title "steady state: mean rotational displacement (single-axis angle x radius)"
 set ylabel "mean rot_disp (grain diameters)"
-plot for [mu in "0.05 0.5"] for [s in "1 2"] "$steady" using (\$1 == mu+0 && \$2 == s+0 ? \$3 : 1/0):5 with linespoints lw 2 pt 7 title sprintf("mu_s %s, seed %s", mu, s)
+plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):5 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+set title "steady state: packing fraction"
+set ylabel "packing fraction"
+plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):6 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+set title "steady state: force on the driven wall at full compression"
+set ylabel "force (N)"
+plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):7 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
 unset multiplot
 EOF
 echo "wrote $per_cycle, $steady, $out/quasistatic.png"

@@ -139,9 +139,11 @@ plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) 
 set title "steady state: mean rotational displacement (single-axis angle x radius)"
 set ylabel "mean rot_disp (grain diameters)"
 plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):5 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+set key center left
 set title "steady state: packing fraction"
 set ylabel "packing fraction"
 plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):6 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+set key center right
 set title "steady state: force on the driven wall at full compression"
 set ylabel "force (N)"
 plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):7 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)

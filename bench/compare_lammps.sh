@@ -190,7 +190,7 @@ for n in $sizes; do
   done
   spc=$(grep -h "^granmem time:" "$out/$tag.time_granmem_t"*.log | head -1 | field steps_per_cycle_paper)
   best=$(awk -v a="${rate[g1]:-0}" -v b="${rate[g2]:-0}" 'BEGIN { print (a > b ? a : b) }')
-  if [[ -n $spc && $best != 0 ]]; then
+  if [[ -n $spc && $best != 0 && $n -ge 20000 ]]; then  # a rate measured at 20,000 grains
     say "  paper run (20,000 grains x 500 cycles x $spc steps) at granmem's best rate here: $(awk -v r="$best" -v s="$spc" 'BEGIN { printf "%.0f h", 2e4 * 500 * s / r / 3600 }')"
   fi
 done

@@ -49,7 +49,8 @@ bool yes_no(const std::map<std::string, std::string>& v, const std::string& name
 
 PhysicsOptions physics_from(const std::map<std::string, std::string>& v);
 // The lid's mass: --lid-mass, or (auto) the mass that presses with --lid-pressure on a
-// square box of side `box`.
+// square box of side `box`. A --lid-mass beside a --lid-pressure other than the default is
+// refused (the settings are text: the default pressure given explicitly is not told apart).
 double lid_mass_from(const std::map<std::string, std::string>& v, double box, double gravity);
 // The deposition (grains, box, lid, seed, settling); checks the sizes.
 DepositOptions deposit_from(const std::map<std::string, std::string>& v);

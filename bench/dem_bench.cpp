@@ -176,7 +176,7 @@ int export_data(const std::vector<std::string>& a) {
 // Steps per cycle of the paper's protocol as `granmem simulate` sets it by default
 // (--period auto: a cosine drive of A = 1 % of the 15 cm box at inertial number 1e-3
 // under the paper's lid pressure), with this packing's grains and time step.
-double paper_steps_per_cycle(const Simulation& sim, double inertial_number = 1e-3) {
+double paper_steps_per_cycle(const Simulation& sim) {
   const auto& p = sim.physics();
   const double diameter = 2 * sim.grains().radius.at(0);
   granmem::WallDrive drive;
@@ -184,8 +184,7 @@ double paper_steps_per_cycle(const Simulation& sim, double inertial_number = 1e-
   const double stress =
       granmem::confining_stress(granmem::kPaperLidPressure, p.density, p.gravity, diameter);
   return std::round(
-      granmem::quasi_static_period(inertial_number, drive, kPaperBox, diameter, stress, p.density) /
-      p.dt);
+      granmem::quasi_static_period(1e-3, drive, kPaperBox, diameter, stress, p.density) / p.dt);
 }
 
 int time_run(const std::vector<std::string>& a) {

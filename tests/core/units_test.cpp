@@ -37,12 +37,6 @@ TEST(Units, LengthConversions) {
   EXPECT_THROW(metres_per("inch"), Error);
 }
 
-}  // namespace
-}  // namespace granmem
-
-namespace granmem {
-namespace {
-
 TEST(Units, PressuresInSi) {
   EXPECT_DOUBLE_EQ(parse_si("436Pa", Dimension::pressure, "", "p"), 436);
   EXPECT_DOUBLE_EQ(parse_si("0.436 kPa", Dimension::pressure, "", "p"), 436);

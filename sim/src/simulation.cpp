@@ -76,6 +76,9 @@ Simulation::Simulation(Grains grains, Container container, PhysicsOptions physic
   std::iota(by_id_.begin(), by_id_.end(), std::size_t{0});
   std::sort(by_id_.begin(), by_id_.end(),
             [&](std::size_t a, std::size_t b) { return grains_.id[a] < grains_.id[b]; });
+  rank_.resize(grains_.size());
+  for (std::size_t r = 0; r < by_id_.size(); ++r)
+    rank_[by_id_[r]] = std::uint32_t(r);
   if (!grains_.mass.empty() && std::all_of(grains_.mass.begin(), grains_.mass.end(),
                                            [&](double m) { return m == grains_.mass.front(); })) {
     uniform_sqrt_reduced_mass_ = sqrt_reduced_mass(grains_.mass.front(), grains_.mass.front());
@@ -115,92 +118,143 @@ void Simulation::refresh_forces() {
   compute_forces(false);
 }
 
-void Simulation::compute_forces(bool commit) {
-  const std::size_t n = grains_.size();
-  const double dt = physics_.dt, half_dt = 0.5 * dt;
-  const auto& partner = neighbors_.partner();
-  Grains& g = grains_;
-
-  // Grain pairs: each evaluated once, by its owner.
-#pragma omp parallel for schedule(dynamic, 128) num_threads(threads_)
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d xi = g.x[i];
-    const double ri = g.radius[i];
-    for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
-      const std::uint32_t j = partner[k];
-      const double reach = ri + g.radius[j];
-      if ((xi - g.x[j]).squaredNorm() >= reach * reach) {
-        active_[k] = 0;
-        if (commit && touching_[k]) {
-          touching_[k] = 0;
-          pair_history_[k] = ContactHistory{};  // the contact broke: forget its springs
-        }
-        continue;
-      }
-      const double sqrt_m = uniform_sqrt_reduced_mass_ > 0
-                                ? uniform_sqrt_reduced_mass_
-                                : sqrt_reduced_mass(g.mass[i], g.mass[j]);
-      const ContactGeometry geometry =
-          sphere_contact(xi, g.x[j], ri, g.radius[j], g.v[i], g.v[j], g.w[i], g.w[j], sqrt_m);
-      const ContactForces f = grain_contact_.evaluate(geometry, pair_history_[k], dt);
-      pair_force_[k] = {f.force_on_i, f.torque_on_i, f.torque_on_j};
-      active_[k] = 1;
-      if (commit) {
-        pair_history_[k] = f.history;
-        touching_[k] = 1;
-      }
+GRANMEM_INLINE bool Simulation::pair_contact(std::size_t i, std::uint32_t k, bool commit,
+                                             PairForce& out) {
+  const Grains& g = grains_;
+  const std::uint32_t j = neighbors_.partner()[k];
+  const double reach = g.radius[i] + g.radius[j];
+  if ((g.x[i] - g.x[j]).squaredNorm() >= reach * reach) {
+    active_[k] = 0;
+    if (commit && touching_[k]) {
+      touching_[k] = 0;
+      pair_history_[k] = ContactHistory{};  // the contact broke: forget its springs
     }
+    return false;
   }
+  const double sqrt_m = uniform_sqrt_reduced_mass_ > 0 ? uniform_sqrt_reduced_mass_
+                                                       : sqrt_reduced_mass(g.mass[i], g.mass[j]);
+  const ContactGeometry geometry = sphere_contact(g.x[i], g.x[j], g.radius[i], g.radius[j], g.v[i],
+                                                  g.v[j], g.w[i], g.w[j], sqrt_m);
+  const ContactForces f = grain_contact_.evaluate(geometry, pair_history_[k], physics_.dt);
+  out = {f.force_on_i, f.torque_on_i, f.torque_on_j};
+  active_[k] = 1;
+  if (commit) {
+    pair_history_[k] = f.history;
+    touching_[k] = 1;
+  }
+  return true;
+}
 
-  // Each grain: its pairs in partner-id order, then the walls in a fixed order.
+GRANMEM_INLINE void Simulation::add_walls(std::size_t i,
+                                          const std::array<Container::Plane, kWallCount>& planes,
+                                          int walls, bool commit, Eigen::Vector3d& f,
+                                          Eigen::Vector3d& t) {
+  const Grains& g = grains_;
+  std::uint8_t touch = 0;
+  const std::uint8_t remembered = wall_remembered_[i];
+  for (int w = 0; w < walls; ++w) {
+    const Container::Plane& p = planes[w];
+    const double distance = p.normal.dot(g.x[i]) - p.offset;
+    ContactHistory& history = wall_history_[i][w];
+    if (distance >= g.radius[i]) {
+      // Forget a broken contact's springs (only where there are some: this loop runs for
+      // every grain and wall each step).
+      if (commit && (remembered & (1u << w))) history = ContactHistory{};
+      continue;
+    }
+    const ContactGeometry geometry =
+        wall_contact(distance, p.normal, g.radius[i], g.v[i], g.w[i], sqrt_mass_[i], p.velocity);
+    const ContactForces c = wall_contact_.evaluate(geometry, history, physics_.dt);
+    if (commit) history = c.history;
+    f += c.force_on_i;
+    t += c.torque_on_i;
+    wall_force_on_grain_[i][w] = -c.force_on_i;
+    touch |= std::uint8_t(1u << w);
+  }
+  wall_touch_[i] = touch;
+  if (commit) wall_remembered_[i] = touch;
+}
+
+Simulation::Share Simulation::share(int thread, int threads) const {
+  const std::size_t n = grains_.size();
+  return {n * std::size_t(thread) / std::size_t(threads),
+          n * std::size_t(thread + 1) / std::size_t(threads)};
+}
+
+void Simulation::start_sums(Share s) {
   const Eigen::Vector3d gravity(0, 0, -physics_.gravity);
   const double drag = physics_.background_damping;
+  Grains& g = grains_;
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t i = by_id_[r];
+    g.force[i] = g.mass[i] * gravity;
+    g.torque[i] = Eigen::Vector3d::Zero();
+    if (drag > 0) {
+      g.force[i] -= drag * g.mass[i] * g.v[i];
+      g.torque[i] -= drag / g.inv_inertia[i] * g.w[i];
+    }
+  }
+}
+
+void Simulation::evaluate_outgoing(Share s, bool commit) {
+  const auto& partner = neighbors_.partner();
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t i = by_id_[r];
+    // Partners are sorted by id: those of another share are the last ones.
+    for (std::uint32_t k = neighbors_.end(i); k-- > neighbors_.begin(i);) {
+      if (rank_[partner[k]] < s.last) break;
+      pair_contact(i, k, commit, pair_force_[k]);
+    }
+  }
+}
+
+void Simulation::add_incoming(Share s) {
   const auto& incoming = neighbors_.incoming();
+  const auto& owner = neighbors_.owner();
+  Grains& g = grains_;
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t j = by_id_[r];
+    // Owners are sorted by id: those of another share are the first ones.
+    for (std::uint32_t e = neighbors_.incoming_begin(j); e < neighbors_.incoming_end(j); ++e) {
+      const std::uint32_t k = incoming[e];
+      if (rank_[owner[k]] >= s.first) break;
+      if (!active_[k]) continue;
+      g.force[j] -= pair_force_[k].force_on_i;
+      g.torque[j] += pair_force_[k].torque_on_j;
+    }
+  }
+}
+
+void Simulation::finish_sums(Share s, bool commit) {
+  Grains& g = grains_;
+  const auto& partner = neighbors_.partner();
+  const double half_dt = 0.5 * physics_.dt;
   const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
   std::array<Container::Plane, kWallCount> planes;
   for (int w = 0; w < walls; ++w)
     planes[w] = container_.plane(static_cast<Wall>(w));
-#pragma omp parallel for schedule(static) num_threads(threads_)
-  for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Vector3d f = g.mass[i] * gravity, t = Eigen::Vector3d::Zero();
-    if (drag > 0) {
-      f -= drag * g.mass[i] * g.v[i];
-      t -= drag / g.inv_inertia[i] * g.w[i];
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t i = by_id_[r];
+    // Every pair of smaller owner id has been added to grain i: its own come next, in
+    // partner-id order, each reaction added at once to the partner's sum.
+    Eigen::Vector3d f = g.force[i], t = g.torque[i];
+    std::uint32_t k = neighbors_.begin(i);
+    for (; k < neighbors_.end(i); ++k) {
+      const std::uint32_t j = partner[k];
+      if (rank_[j] >= s.last) break;
+      PairForce c;
+      if (!pair_contact(i, k, commit, c)) continue;
+      f += c.force_on_i;
+      t += c.torque_on_i;
+      g.force[j] -= c.force_on_i;
+      g.torque[j] += c.torque_on_j;
     }
-    for (std::uint32_t s = neighbors_.incoming_begin(i); s < neighbors_.incoming_end(i); ++s) {
-      const std::uint32_t k = incoming[s];
-      if (!active_[k]) continue;
-      f -= pair_force_[k].force_on_i;
-      t += pair_force_[k].torque_on_j;
-    }
-    for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
+    for (; k < neighbors_.end(i); ++k) {  // evaluated before, for the partner's share
       if (!active_[k]) continue;
       f += pair_force_[k].force_on_i;
       t += pair_force_[k].torque_on_i;
     }
-    std::uint8_t touch = 0;
-    const std::uint8_t remembered = wall_remembered_[i];
-    for (int w = 0; w < walls; ++w) {
-      const Container::Plane& p = planes[w];
-      const double distance = p.normal.dot(g.x[i]) - p.offset;
-      ContactHistory& history = wall_history_[i][w];
-      if (distance >= g.radius[i]) {
-        // Forget a broken contact's springs (only where there are some: this loop runs for
-        // every grain and wall each step).
-        if (commit && (remembered & (1u << w))) history = ContactHistory{};
-        continue;
-      }
-      const ContactGeometry geometry =
-          wall_contact(distance, p.normal, g.radius[i], g.v[i], g.w[i], sqrt_mass_[i], p.velocity);
-      const ContactForces c = wall_contact_.evaluate(geometry, history, dt);
-      if (commit) history = c.history;
-      f += c.force_on_i;
-      t += c.torque_on_i;
-      wall_force_on_grain_[i][w] = -c.force_on_i;
-      touch |= std::uint8_t(1u << w);
-    }
-    wall_touch_[i] = touch;
-    if (commit) wall_remembered_[i] = touch;
+    add_walls(i, planes, walls, commit, f, t);
     g.force[i] = f;
     g.torque[i] = t;
     if (commit) {  // the step's second half kick, while the grain is at hand
@@ -208,7 +262,32 @@ void Simulation::compute_forces(bool commit) {
       g.w[i] += half_dt * g.inv_inertia[i] * t;
     }
   }
+}
 
+// Each grain's forces are summed in the order of its partners' ids: gravity and drag, the
+// pairs it is partner of (owners of smaller id, in id order), then its own pairs (partners
+// of larger id, in id order), then the walls. Grains are walked in id order, each thread
+// over one share of consecutive ids: a pair's reaction is added to its partner as soon as
+// it is evaluated, except across shares, where it is stored, and added first once every
+// thread is done with such pairs (their owners' ids are smaller than any in the share).
+void Simulation::compute_forces(bool commit) {
+#pragma omp parallel num_threads(threads_)
+  {
+    const int threads = omp_get_num_threads();
+    const Share s = share(omp_get_thread_num(), threads);
+    start_sums(s);
+    if (threads > 1) {
+      evaluate_outgoing(s, commit);
+#pragma omp barrier
+      add_incoming(s);
+    }
+    finish_sums(s, commit);
+  }
+  sum_wall_loads();
+}
+
+void Simulation::sum_wall_loads() {
+  const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
   // Loads on the walls, summed in the order of grain ids (the lid's motion depends on them).
   wall_loads_ = WallLoads{};
   for (std::size_t i : by_id_) {
@@ -223,7 +302,7 @@ void Simulation::compute_forces(bool commit) {
   Lid& lid = container_.lid;
   if (lid.present) {
     lid.force = wall_loads_.force[int(Wall::lid)].z() - lid.mass * physics_.gravity -
-                drag * lid.mass * lid.v;
+                physics_.background_damping * lid.mass * lid.v;
   }
 }
 

@@ -114,6 +114,21 @@ class Simulation {
   struct PairForce {
     Eigen::Vector3d force_on_i, torque_on_i, torque_on_j;
   };
+  // A thread's grains: positions [first, last) of the grains in id order.
+  struct Share {
+    std::size_t first, last;
+  };
+  Share share(int thread, int threads) const;
+  // The stages of compute_forces, over one share.
+  void start_sums(Share s);
+  void evaluate_outgoing(Share s, bool commit);
+  void add_incoming(Share s);
+  void finish_sums(Share s, bool commit);
+  void sum_wall_loads();
+  // Pair k, owned by grain i: false if its grains do not touch, else its forces in `out`.
+  bool pair_contact(std::size_t i, std::uint32_t k, bool commit, PairForce& out);
+  void add_walls(std::size_t i, const std::array<Container::Plane, kWallCount>& planes, int walls,
+                 bool commit, Eigen::Vector3d& f, Eigen::Vector3d& t);
 
   Grains grains_;
   Container container_;
@@ -124,14 +139,15 @@ class Simulation {
   std::vector<ContactHistory> pair_history_;
   std::vector<std::uint8_t> touching_;  // the pair has a committed contact history
   std::vector<std::uint8_t> active_;    // the pair overlaps at the last force evaluation
-  std::vector<PairForce> pair_force_;
+  std::vector<PairForce> pair_force_;   // of the pairs whose grains are in two shares
   std::vector<std::array<ContactHistory, kWallCount>> wall_history_;
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
   std::vector<std::uint8_t> wall_touch_;       // bit w: grain touches wall w
   std::vector<std::uint8_t> wall_remembered_;  // bit w: a committed history against wall w
   WallLoads wall_loads_;
-  std::vector<std::size_t> by_id_;  // grain indices in increasing id
-  std::vector<double> sqrt_mass_;   // for the wall contacts' dashpots
+  std::vector<std::size_t> by_id_;   // grain indices in increasing id
+  std::vector<std::uint32_t> rank_;  // each grain's position in by_id_
+  std::vector<double> sqrt_mass_;    // for the wall contacts' dashpots
   static constexpr std::size_t kGrainsPerThread = 2500;
   int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass

@@ -168,15 +168,7 @@ SimulateSettings add_simulate(CLI::App& app) {
     c.drive = drive_from(v, physics, box, box_y, lid_mass, radius);
     c.out = out;
     c.full_compression_frames = yes_no(v, "full-compression");
-    std::stringstream track(v.at("track"));
-    for (std::string id; std::getline(track, id, ',');) {
-      if (id.empty()) continue;
-      const Quantity q = parse_quantity(id, "--track");
-      if (!q.unit.empty() || q.value != std::floor(q.value)) {
-        throw Error("--track '" + v.at("track") + "': expected grain ids, e.g. 3,17,250");
-      }
-      c.tracked_grains.push_back(std::int64_t(q.value));
-    }
+    c.tracked_grains = whole_list(v, "track", "3,17,250");
     c.samples_per_cycle = whole(v, "samples-per-cycle");
     if (c.tracked_grains.empty() != (c.samples_per_cycle == 0)) {
       throw Error("--track and --samples-per-cycle go together: which grains, and how often");
@@ -194,9 +186,12 @@ SimulateSettings add_simulate(CLI::App& app) {
     }
     c.checkpoint = checkpoint;
     c.checkpoint_every = whole(v, "checkpoint-every");
+    c.keep_states = whole_list(v, "keep-states", "10,50,100");
     c.validate(box_y, physics.dt);
     {
       std::vector<std::filesystem::path> outputs{c.out, c.checkpoint};
+      for (std::int64_t cycle : c.keep_states)
+        outputs.push_back(kept_state_path(c.out, cycle));
       if (c.full_compression_frames) outputs.push_back(full_compression_path(c.out));
       if (c.samples_per_cycle > 0) outputs.push_back(in_cycle_path(c.out));
       check_outputs(outputs, *start_from);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iterator>
+#include <sstream>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
@@ -50,6 +51,9 @@ const OptionSpec kSimulateOptions[] = {
     {"track", "", "grain ids sampled inside cycles, comma list"},
     {"samples-per-cycle", "0", "in-cycle samples of the tracked grains"},
     {"checkpoint-every", "0", "cycles between checkpoints (0: at the end and on Ctrl-C)"},
+    {"keep-states", "",
+     "cycles after which the full state is kept (<out>_state_cycle<N>.h5), comma list: "
+     "trained states for granmem readout"},
     {"checkpoint", "", "checkpoint file (default <out>.checkpoint.h5)"},
     {"out", "run.h5", "end-of-cycle trajectory store"},
 };
@@ -182,6 +186,21 @@ WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsO
     d.period = si(v, "period", Dimension::time);
   }
   return d;
+}
+
+std::vector<std::int64_t> whole_list(const std::map<std::string, std::string>& v,
+                                     const std::string& name, const char* example) {
+  std::vector<std::int64_t> out;
+  std::stringstream list(v.at(name));
+  for (std::string item; std::getline(list, item, ',');) {
+    if (item.empty()) continue;
+    const Quantity q = parse_quantity(item, "--" + name);
+    if (!q.unit.empty() || q.value != std::floor(q.value)) {
+      throw Error("--" + name + " '" + v.at(name) + "': expected whole numbers, e.g. " + example);
+    }
+    out.push_back(std::int64_t(q.value));
+  }
+  return out;
 }
 
 bool wall_friction_follows(const std::map<std::string, std::string>& v) {

@@ -5,6 +5,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "granmem/core/units.hpp"
 #include "granmem/sim/deposit.hpp"
@@ -58,6 +59,9 @@ DepositOptions deposit_from(const std::map<std::string, std::string>& v);
 // `period auto` is the quasi-static limit of the inertial number.
 WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsOptions& physics,
                      double box, double box_y, double lid_mass, double radius);
+// A comma list of whole numbers (grain ids, cycles); `example` shows one in the error.
+std::vector<std::int64_t> whole_list(const std::map<std::string, std::string>& v,
+                                     const std::string& name, const char* example);
 // Walls' friction follows the grains' ("same").
 bool wall_friction_follows(const std::map<std::string, std::string>& v);
 

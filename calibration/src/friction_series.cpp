@@ -1,14 +1,10 @@
 #include "granmem/calibration/friction_series.hpp"
 
-#include <omp.h>
-
-#include <atomic>
 #include <cstdio>
-#include <exception>
 #include <mutex>
-#include <thread>
 
 #include "granmem/core/error.hpp"
+#include "granmem/sim/run_pool.hpp"
 
 namespace granmem {
 
@@ -53,43 +49,22 @@ std::vector<std::filesystem::path> run_friction_series(
   std::vector<std::filesystem::path> out;
   for (const FrictionRunSpec& r : runs)
     out.push_back(friction_run_path(options.dir, r));
-  const int workers =
-      std::max(1, std::min<int>(int(runs.size()), options.parallel > 0
-                                                      ? options.parallel
-                                                      : int(std::thread::hardware_concurrency())));
-  std::atomic<std::size_t> next{0};
   std::mutex report;
-  std::exception_ptr failure;
-  auto work = [&] {
-    for (std::size_t k; (k = next++) < runs.size();) {
-      try {
-        Simulation sim = start(runs[k]);
-        sim.set_threads(1);  // parallel over runs: one thread each
-        CyclicOptions c = options.protocol;
-        c.out = out[k];
-        c.checkpoint.clear();
-        c.parameters["calibrate/mu_s"] = std::to_string(runs[k].mu_s);
-        c.parameters["calibrate/seed"] = std::to_string(runs[k].seed);
-        ProtocolState state;
-        run_cycles(sim, c, state, [&](const CyclicProgress& p) {
-          if (!progress) return;
-          const std::lock_guard<std::mutex> lock(report);
-          progress(k, p);
-        });
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(report);
-        if (!failure) failure = std::current_exception();
-        next = runs.size();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 1; w < workers; ++w)
-    pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool)
-    t.join();
-  if (failure) std::rethrow_exception(failure);
+  run_pool(runs.size(), {options.parallel}, [&](std::size_t k) {
+    Simulation sim = start(runs[k]);
+    sim.set_threads(1);  // parallel over runs: one thread each
+    CyclicOptions c = options.protocol;
+    c.out = out[k];
+    c.checkpoint.clear();
+    c.parameters["calibrate/mu_s"] = std::to_string(runs[k].mu_s);
+    c.parameters["calibrate/seed"] = std::to_string(runs[k].seed);
+    ProtocolState state;
+    run_cycles(sim, c, state, [&](const CyclicProgress& p) {
+      if (!progress) return;
+      const std::lock_guard<std::mutex> lock(report);
+      progress(k, p);
+    });
+  });
   return out;
 }
 

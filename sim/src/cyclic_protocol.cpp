@@ -1,5 +1,6 @@
 #include "granmem/sim/cyclic_protocol.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -17,6 +18,10 @@ std::filesystem::path full_compression_path(const std::filesystem::path& out) {
 }
 std::filesystem::path in_cycle_path(const std::filesystem::path& out) {
   return out.parent_path() / (out.stem().string() + "_in_cycle" + out.extension().string());
+}
+
+std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle) {
+  return out.parent_path() / (out.stem().string() + "_state_cycle" + std::to_string(cycle) + ".h5");
 }
 
 namespace {
@@ -101,6 +106,9 @@ void CyclicOptions::validate(double box_y, double dt) const {
   }
   if (samples_per_cycle < 0 || checkpoint_every < 0) {
     throw Error("samples per cycle and checkpoint interval must be zero or positive");
+  }
+  for (std::int64_t c : keep_states) {
+    if (c < 1) throw Error("kept state after cycle " + std::to_string(c) + ": cycles count from 1");
   }
 }
 
@@ -261,9 +269,16 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
     const auto pending = state.pending.find("wall_force_full_compression");
     end_of_cycle_observables(pending != state.pending.end() ? pending->second : std::nan(""));
     report(true);
-    if (o.checkpoint_every > 0 && state.cycles_done % o.checkpoint_every == 0 &&
-        state.cycles_done < o.cycles) {
+    const bool keep = std::find(o.keep_states.begin(), o.keep_states.end(), state.cycles_done) !=
+                      o.keep_states.end();
+    if (keep || (o.checkpoint_every > 0 && state.cycles_done % o.checkpoint_every == 0 &&
+                 state.cycles_done < o.cycles)) {
       save(false);
+    }
+    if (keep) {
+      const std::filesystem::path kept = kept_state_path(o.out, state.cycles_done);
+      write_checkpoint(kept, sim, state);
+      summary.written.push_back(kept);
     }
   }
   save(true);

@@ -4,12 +4,14 @@
 // and the final state. So does a run on 1 thread and on 2.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <thread>
 
+#include "granmem/core/error.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
@@ -145,6 +147,50 @@ TEST_F(Restart, ResumedAtTheEndOfACycleWritesTheSameRunBitForBit) {
   expect_same_outputs(a, b);
   expect_same_state(whole, sim);
   EXPECT_EQ(read_trajectories(b.out).frames.size(), 4u);  // the packing, then 3 cycles
+}
+
+// States kept after cycles 1 and 2 of the run: a new protocol of one more cycle started
+// from the second is the run's third cycle, bit for bit (a read-out at the training
+// amplitude continues the training); --resume from the first continues the whole run.
+TEST_F(Restart, AKeptStateStartsTheRestOfTheRunBitForBit) {
+  Simulation whole = small_packing();
+  const CyclicOptions a = whole_run(&whole);
+
+  fs::create_directories(path("kept"));
+  CyclicOptions b = cycles_into(path("kept"), 3);
+  b.keep_states = {1, 2};
+  {
+    Simulation sim = small_packing();
+    ProtocolState state;
+    const CyclicSummary s = run_cycles(sim, b, state);
+    EXPECT_EQ(std::count(s.written.begin(), s.written.end(), kept_state_path(b.out, 2)), 1);
+    expect_same_state(whole, sim);  // keeping states does not change the run
+  }
+  ProtocolState kept;
+  Simulation from_2 = read_checkpoint(kept_state_path(b.out, 2), &kept);
+  EXPECT_EQ(kept.cycles_done, 2);
+  EXPECT_EQ(kept.step_in_cycle, 0);
+  fs::create_directories(path("next"));
+  CyclicOptions next = cycles_into(path("next"), 1);
+  ProtocolState fresh;
+  run_cycles(from_2, next, fresh);
+  expect_same_state(whole, from_2);
+
+  ProtocolState resumed;
+  Simulation from_1 = read_checkpoint(kept_state_path(b.out, 1), &resumed);
+  EXPECT_EQ(run_cycles(from_1, b, resumed).cycles_done, 3);
+  expect_same_outputs(a, b);
+  expect_same_state(whole, from_1);
+}
+
+TEST(KeptStates, CyclesBeforeTheFirstAreRefused) {
+  CyclicOptions o;
+  o.drive.amplitude = 1e-3;
+  o.drive.period = 0.02;
+  o.keep_states = {0};
+  EXPECT_THROW(o.validate(0.02, 25e-6), Error);
+  o.keep_states = {1};
+  EXPECT_NO_THROW(o.validate(0.02, 25e-6));
 }
 
 // Runs the cycles with a stop request from another thread shortly after cycle `after`

@@ -27,6 +27,9 @@ struct CyclicOptions {
   std::filesystem::path checkpoint;               // where checkpoints go; empty: none
   std::int64_t checkpoint_every = 0;              // cycles between checkpoints; 0: at the end only
   std::map<std::string, std::string> parameters;  // written into the outputs' /parameters
+  // Cycles after which the full state is kept, as a checkpoint at
+  // kept_state_path(out, cycle): the trained states that a memory read-out starts from.
+  std::vector<std::int64_t> keep_states;
 
   // Throws Error for settings no run can use in a box of this depth along y with this step
   // (amplitude of half the box or more, no cycles, a period under four steps).
@@ -49,6 +52,8 @@ struct CyclicSummary {
 
 std::filesystem::path full_compression_path(const std::filesystem::path& out);
 std::filesystem::path in_cycle_path(const std::filesystem::path& out);
+// <out stem>_state_cycle<cycle>.h5
+std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle);
 
 // Runs the cycles from `state` (a fresh ProtocolState starts at cycle 1 and writes the
 // state before it as frame 0; one read from a checkpoint continues where it stopped,
@@ -56,7 +61,8 @@ std::filesystem::path in_cycle_path(const std::filesystem::path& out);
 // and cavity axis; per-cycle observables: wall_force and wall_force_full_compression (N,
 // the packing's push on the driven wall), lid_height (m), packing_fraction,
 // kinetic_energy (J), contacts_per_grain. Checks `stop` every step: when set, it writes
-// a checkpoint and returns.
+// a checkpoint and returns. Kept states are written with the outputs published up to
+// their cycle, so that --resume from one also continues the run exactly.
 CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& options, ProtocolState& state,
                          const std::function<void(const CyclicProgress&)>& progress = {},
                          const std::atomic<bool>* stop = nullptr);

@@ -20,6 +20,7 @@ struct SimulateSettings;
 SimulateSettings add_simulate(CLI::App& app);
 void add_calibrate(CLI::App& app, const SimulateSettings& twin);
 void add_compare(CLI::App& app);
+void add_readout(CLI::App& app);
 void add_locate(CLI::App& app);
 void add_track(CLI::App& app);
 void add_render(CLI::App& app);

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   granmem::app::add_export(app);
   const granmem::app::SimulateSettings twin = granmem::app::add_simulate(app);
   granmem::app::add_calibrate(app, twin);
+  granmem::app::add_readout(app);
   granmem::app::add_compare(app);
   granmem::app::add_locate(app);
   granmem::app::add_track(app);

@@ -1,6 +1,7 @@
 #include "parse.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
@@ -86,6 +87,16 @@ VoxelSize parse_voxel_size(const std::string& text, const std::string& option) {
     out.size[a] = value;
   }
   return out;
+}
+
+std::string duration_text(double seconds) {
+  const auto s = std::llround(seconds);
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%lldh%02lldm", s / 3600, (s % 3600) / 60);
+  else
+    std::snprintf(buf, sizeof buf, "%lldm%02llds", s / 60, s % 60);
+  return buf;
 }
 
 }  // namespace granmem::app

@@ -30,4 +30,7 @@ struct VoxelSize {
 };
 VoxelSize parse_voxel_size(const std::string& text, const std::string& option);
 
+// A time left, as a person reads it: "4m05s", "2h10m".
+std::string duration_text(double seconds);
+
 }  // namespace granmem::app

@@ -16,6 +16,7 @@
 #include "granmem/sim/cyclic_protocol.hpp"
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/quasi_static.hpp"
+#include "parse.hpp"
 #include "simulation_settings.hpp"
 
 namespace granmem::app {
@@ -47,16 +48,6 @@ void check_outputs(const std::vector<std::filesystem::path>& outputs,
     }
     seen.push_back(full);
   }
-}
-
-std::string duration_text(double seconds) {
-  const auto s = std::llround(seconds);
-  char buf[32];
-  if (s >= 3600)
-    std::snprintf(buf, sizeof buf, "%lldh%02lldm", s / 3600, (s % 3600) / 60);
-  else
-    std::snprintf(buf, sizeof buf, "%lldm%02llds", s / 60, s % 60);
-  return buf;
 }
 
 }  // namespace

@@ -166,15 +166,14 @@ DepositOptions deposit_from(const std::map<std::string, std::string>& v) {
 WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsOptions& physics,
                      double box, double box_y, double lid_mass, double radius) {
   WallDrive d;
-  const std::string& amplitude = v.at("amplitude");
-  d.amplitude =
-      !amplitude.empty() && amplitude.back() == '%'
-          ? number({{"amplitude", amplitude.substr(0, amplitude.size() - 1)}}, "amplitude") / 100 *
-                box_y
-          : si(v, "amplitude", Dimension::length);
+  d.amplitude = parse_amplitude(v.at("amplitude"), box_y, "--amplitude");
   d.symmetry = parse_drive_symmetry(v.at("drive"));
   d.shape = parse_drive_shape(v.at("wall-motion"));
   if (v.at("period") == "auto") {
+    if (!(d.amplitude > 0)) {
+      throw Error("--amplitude " + v.at("amplitude") +
+                  ": a still wall has no quasi-static period; give --period");
+    }
     if (!(number(v, "inertial-number") > 0)) {
       throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
     }

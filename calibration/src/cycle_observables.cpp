@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/core/units.hpp"
 
 namespace granmem {
@@ -46,8 +47,7 @@ double median_diameter(const TrajectoryReader& run) {
     if (std::isfinite(x) && x > 0) r.push_back(x);
   }
   if (r.empty()) throw Error(run.file_name() + ": no grain radius; give the grain diameter");
-  std::nth_element(r.begin(), r.begin() + std::ptrdiff_t(r.size() / 2), r.end());
-  return 2 * r[r.size() / 2] * metres_per_length(run);
+  return 2 * median(r) * metres_per_length(run);
 }
 
 CycleObservables cycle_observables(const TrajectoryReader& run, const ObservableOptions& options) {

@@ -8,6 +8,38 @@
 
 namespace granmem {
 
+double median(std::vector<double> values) {
+  values.erase(
+      std::remove_if(values.begin(), values.end(), [](double x) { return !std::isfinite(x); }),
+      values.end());
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(mid), values.end());
+  const double upper = values[mid];
+  if (values.size() % 2 == 1) return upper;
+  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + std::ptrdiff_t(mid)));
+}
+
+double bootstrap_standard_error(const std::vector<double>& values, std::size_t resamples,
+                                Random& random) {
+  std::vector<double> v;
+  for (double x : values) {
+    if (std::isfinite(x)) v.push_back(x);
+  }
+  if (v.size() < 2 || resamples < 2) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0, sum_sq = 0;
+  for (std::size_t b = 0; b < resamples; ++b) {
+    double total = 0;
+    for (std::size_t k = 0; k < v.size(); ++k)
+      total += v[std::min(v.size() - 1, std::size_t(random.uniform() * double(v.size())))];
+    const double mean = total / double(v.size());
+    sum += mean;
+    sum_sq += mean * mean;
+  }
+  const double n = double(resamples), mean = sum / n;
+  return std::sqrt(std::max(0.0, (sum_sq - n * mean * mean) / (n - 1)));
+}
+
 Summary summarize(const std::vector<double>& values) {
   std::vector<double> v;
   v.reserve(values.size());
@@ -28,12 +60,7 @@ Summary summarize(const std::vector<double>& values) {
   }
   s.mean = sum / double(v.size());
   s.mean_square = sum_sq / double(v.size());
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(mid), v.end());
-  s.median = v[mid];
-  if (v.size() % 2 == 0) {
-    s.median = 0.5 * (s.median + *std::max_element(v.begin(), v.begin() + std::ptrdiff_t(mid)));
-  }
+  s.median = median(std::move(v));
   return s;
 }
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 
 namespace granmem {
@@ -89,7 +90,8 @@ std::optional<double> parse_number(std::string_view field) {
 
 void write_csv(const Table& table, const std::filesystem::path& path,
                const std::vector<std::string>& comment) {
-  std::ofstream out(path, std::ios::binary);
+  AtomicFile file(path);  // a failed write leaves any earlier table in place
+  std::ofstream out(file.temp_path(), std::ios::binary);
   if (!out) throw Error(path.string() + ": cannot open for writing");
   std::string text;
   for (const std::string& line : comment)
@@ -110,8 +112,9 @@ void write_csv(const Table& table, const std::filesystem::path& path,
     }
   }
   out << text;
-  out.flush();
+  out.close();
   if (!out) throw Error(path.string() + ": write failed (disk full?)");
+  file.commit();
 }
 
 CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::string>& required,

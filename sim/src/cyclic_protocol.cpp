@@ -96,7 +96,8 @@ struct Output {
 
 void CyclicOptions::validate(double box_y, double dt) const {
   if (cycles < 1) throw Error("cycles: at least one cycle is needed");
-  if (!(drive.amplitude > 0)) throw Error("amplitude: must be positive");
+  // 0 keeps the wall still for the period: the read-out's reference of no drive.
+  if (!(drive.amplitude >= 0)) throw Error("amplitude: must be zero or positive");
   if (drive.amplitude >= 0.5 * box_y) {
     throw Error("amplitude " + std::to_string(drive.amplitude) +
                 " m: must be less than half the box (" + std::to_string(box_y) + " m)");

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/units.hpp"
 
 namespace granmem {
 
@@ -39,6 +40,16 @@ double WallDrive::period_for_speed(double amplitude, double speed, DriveSymmetry
                                    DriveShape shape) {
   // Both symmetries travel 2A per period; a cosine's peak speed is pi/2 times its mean.
   return shape == DriveShape::cosine ? M_PI * amplitude / speed : 2 * amplitude / speed;
+}
+
+double parse_amplitude(const std::string& text, double box_y, const std::string& what) {
+  const std::string_view t = trim(text);
+  if (!t.empty() && t.back() == '%') {
+    const Quantity q = parse_quantity(t.substr(0, t.size() - 1), what);
+    if (!q.unit.empty()) throw Error(what + " '" + text + "': expected a percentage, e.g. 1%");
+    return q.value / 100 * box_y;
+  }
+  return parse_si(t, Dimension::length, "", what);
 }
 
 DriveSymmetry parse_drive_symmetry(const std::string& text) {

@@ -227,5 +227,28 @@ TEST(ProbabilityDensity, InvalidRangeIsAnError) {
   EXPECT_EQ(probability_density({1, 2, 3}, o)["count"].values, (std::vector<double>{3, 0}));
 }
 
+TEST(Median, OfTheFiniteValuesWithTheMiddleTwoAveraged) {
+  EXPECT_EQ(median({3, 1, 2}), 2);
+  EXPECT_EQ(median({4, 1, 3, 2}), 2.5);
+  EXPECT_EQ(median({kNaN, 5, kInf, 1}), 3);
+  EXPECT_TRUE(std::isnan(median({kNaN})));
+}
+
+// The bootstrap's standard error of a mean is sigma / sqrt(n) for independent values.
+TEST(BootstrapStandardError, IsSigmaOverRootNForIndependentValues) {
+  Random draw(7), resample(8);
+  std::vector<double> values;
+  for (int k = 0; k < 400; ++k)
+    values.push_back(2.0 + 0.5 * draw.normal());
+  const Summary s = summarize(values);
+  const double sigma = std::sqrt(s.mean_square - s.mean * s.mean);
+  const double expected = sigma / std::sqrt(400.0);
+  EXPECT_NEAR(bootstrap_standard_error(values, 2000, resample), expected, 0.06 * expected);
+  values.push_back(kNaN);  // not measured: left out
+  EXPECT_NEAR(bootstrap_standard_error(values, 2000, resample), expected, 0.06 * expected);
+  EXPECT_EQ(bootstrap_standard_error(std::vector<double>(10, 1.0), 100, resample), 0);
+  EXPECT_TRUE(std::isnan(bootstrap_standard_error({1.0}, 100, resample)));
+}
+
 }  // namespace
 }  // namespace granmem

@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "granmem/core/random.hpp"
 #include "granmem/core/table.hpp"
 
 namespace granmem {
@@ -18,6 +19,16 @@ struct Summary {
   double mean_square = 0;
 };
 Summary summarize(const std::vector<double>& values);
+
+// The median of the finite values (the mean of the middle two for an even count); NaN if
+// there are none.
+double median(std::vector<double> values);
+
+// The standard error of the mean of the finite values, from `resamples` bootstrap draws of
+// as many values with replacement: the spread of the mean over resamples of the grains.
+// NaN with fewer than two values.
+double bootstrap_standard_error(const std::vector<double>& values, std::size_t resamples,
+                                Random& random);
 
 enum class BinScale { linear, logarithmic };
 

@@ -32,7 +32,8 @@ struct CyclicOptions {
   std::vector<std::int64_t> keep_states;
 
   // Throws Error for settings no run can use in a box of this depth along y with this step
-  // (amplitude of half the box or more, no cycles, a period under four steps).
+  // (a negative amplitude or one of half the box or more, no cycles, a period under four
+  // steps). Amplitude 0 keeps the wall still for a period.
   void validate(double box_y, double dt) const;
 };
 

@@ -27,6 +27,11 @@ struct WallDrive {
                                  DriveShape shape);
 };
 
+// An amplitude as given on the command line or in a checkpoint's settings: a percentage
+// of the box's depth `box_y` along the drive ("1%") or a length with its unit ("0.15cm").
+// Returns metres; Error naming `what` for anything else.
+double parse_amplitude(const std::string& text, double box_y, const std::string& what);
+
 DriveSymmetry parse_drive_symmetry(const std::string& text);
 DriveShape parse_drive_shape(const std::string& text);
 

@@ -1,0 +1,144 @@
+#include "granmem/calibration/readout.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// A run's bootstrap seed from its store's name, so that its error bars do not depend on
+// where the run stands in the sweep (FNV-1a: the same on every platform).
+std::uint64_t run_seed(std::uint64_t seed, const std::filesystem::path& store) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (unsigned char c : store.filename().string()) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return seed ^ h;
+}
+
+struct MeanWithError {
+  double mean = kNaN, error = kNaN;
+};
+MeanWithError mean_with_error(const std::vector<double>& values, const ReadoutOptions& o,
+                              Random& random) {
+  return {summarize(values).mean, bootstrap_standard_error(values, o.bootstrap, random)};
+}
+
+}  // namespace
+
+std::vector<ReadoutPoint> readout_points(const ReadoutRun& run, const ReadoutOptions& o) {
+  const TrajectoryReader store(run.store);
+  const RunHeader& h = store.header();
+  if (store.frame_count() < 2) {
+    throw Error(run.store.string() + ": a read-out run needs the trained state and a cycle");
+  }
+  const double metres = metres_per(h.length_unit);
+  const double to_d = metres / median_diameter(store);
+  MotionOptions motion = o.motion;
+  motion.wall_distance /= metres;
+  Random random(run_seed(o.seed, run.store));
+  const Frame trained = store.read_frame(0);
+  Frame before = trained;
+  std::vector<ReadoutPoint> points;
+  for (std::size_t t = 1; t < store.frame_count(); ++t) {
+    const Frame after = store.read_frame(t);
+    const FrameMotion m = grain_motion(h, trained, after, motion);
+    std::vector<double> dr, dr2, single, full;
+    for (std::size_t k = 0; k < m.grain.size(); ++k) {
+      dr.push_back(m.dr[k] * to_d);
+      dr2.push_back(dr.back() * dr.back());
+      single.push_back(m.has_rotation ? m.theta_axis[k] * 0.5 : kNaN);  // angle d/2, in d
+      if (!m.theta_full.empty()) full.push_back(m.theta_full[k] * 0.5);
+    }
+    ReadoutPoint p;
+    p.state = run.state;
+    p.trained_cycles = run.trained_cycles;
+    p.training_amplitude = run.training_amplitude;
+    p.amplitude = run.amplitude;
+    p.cycle = store.steps()[t];
+    p.grains = m.grain.size();
+    MeanWithError e = mean_with_error(dr, o, random);
+    p.dr = e.mean;
+    p.dr_error = e.error;
+    e = mean_with_error(dr2, o, random);
+    p.msd = e.mean;
+    p.msd_error = e.error;
+    e = mean_with_error(single, o, random);
+    p.rot_single = e.mean;
+    p.rot_single_error = e.error;
+    e = mean_with_error(full, o, random);
+    p.rot_full = e.mean;
+    p.rot_full_error = e.error;
+    p.reversibility = kNaN;
+    if (t > 1) {
+      const FrameMotion step = grain_motion(h, before, after, motion);
+      p.reversibility = summarize(step.dr).mean * to_d;
+    }
+    points.push_back(p);
+    before = after;
+  }
+  return points;
+}
+
+Table readout_table(const std::vector<ReadoutPoint>& points) {
+  Table t;
+  Column& state = t.add("state", "", true);
+  Column& trained = t.add("trained_cycles", "", true);
+  Column& training = t.add("training_amplitude_pct", "%");
+  Column& amplitude = t.add("amplitude_pct", "%");
+  Column& cycle = t.add("cycle", "", true);
+  Column& grains = t.add("grains", "", true);
+  std::vector<std::pair<Column*, double ReadoutPoint::*>> lengths = {
+      {&t.add("dr_d", "d"), &ReadoutPoint::dr},
+      {&t.add("dr_err_d", "d"), &ReadoutPoint::dr_error},
+      {&t.add("msd_d2", "d^2"), &ReadoutPoint::msd},
+      {&t.add("msd_err_d2", "d^2"), &ReadoutPoint::msd_error},
+      {&t.add("rot_single_d", "d"), &ReadoutPoint::rot_single},
+      {&t.add("rot_single_err_d", "d"), &ReadoutPoint::rot_single_error},
+      {&t.add("rot_full_d", "d"), &ReadoutPoint::rot_full},
+      {&t.add("rot_full_err_d", "d"), &ReadoutPoint::rot_full_error},
+      {&t.add("reversibility_d", "d"), &ReadoutPoint::reversibility}};
+  for (const ReadoutPoint& p : points) {
+    state.values.push_back(double(p.state));
+    trained.values.push_back(double(p.trained_cycles));
+    training.values.push_back(p.training_amplitude * 100);
+    amplitude.values.push_back(p.amplitude * 100);
+    cycle.values.push_back(double(p.cycle));
+    grains.values.push_back(double(p.grains));
+    for (auto& [column, field] : lengths)
+      column->values.push_back(p.*field);
+  }
+  return t;
+}
+
+ReadoutSummary readout(const ReadoutOptions& o,
+                       const std::function<void(const ReadoutSweepProgress&)>& progress) {
+  ReadoutSummary s;
+  s.sweep = run_readout_sweep(o.sweep, progress);
+  for (const ReadoutRun& run : s.sweep.runs) {
+    const std::vector<ReadoutPoint> points = readout_points(run, o);
+    s.points.insert(s.points.end(), points.begin(), points.end());
+  }
+  s.diameter = median_diameter(TrajectoryReader(s.sweep.runs.front().store));
+  s.table = o.sweep.dir / "readout.csv";
+  std::vector<std::string> comment = {
+      "granmem readout: displacements from each trained state at the end of each read-out "
+      "cycle, in grain diameters d = " +
+      std::to_string(s.diameter) + " m; errors: bootstrap over grains"};
+  for (std::size_t k = 0; k < o.sweep.states.size(); ++k)
+    comment.push_back("state " + std::to_string(k) + ": " + o.sweep.states[k].string());
+  write_csv(readout_table(s.points), s.table, comment);
+  return s;
+}
+
+}  // namespace granmem

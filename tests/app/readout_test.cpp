@@ -1,0 +1,75 @@
+// `granmem readout` end to end: states kept by `simulate --keep-states`, read out at a sweep
+// of amplitudes; at the training amplitude the read-out is the simulated run's next cycle,
+// bit for bit; a second call reuses the finished runs; bad input is refused in one line.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "granmem/core/trajectory_store.hpp"
+#include "run_granmem.hpp"
+
+namespace granmem::testing {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 60 grains in a 2 cm box, trained 2 cycles at 2 % (the period from a fast inertial number:
+// seconds in all), the state after cycle 1 kept.
+class Readout : public GranmemTest {
+ protected:
+  void SetUp() override {
+    GranmemTest::SetUp();
+    granmem_ok({"simulate", "--grains", "60", "--box", "2cm", "--amplitude", "2%",
+                "--inertial-number", "1e-2", "--cycles", "2", "--keep-states", "1", "--out",
+                "train.h5"});
+  }
+};
+
+bool same_positions(const Frame& a, const Frame& b) {
+  return a.position.size() == b.position.size() &&
+         std::memcmp(a.position.data(), b.position.data(),
+                     sizeof(double) * std::size_t(a.position.size())) == 0;
+}
+
+TEST_F(Readout, AtTheTrainingAmplitudeItIsTheRunsNextCycleAndFinishedRunsAreReused) {
+  const std::vector<std::string> args = {"readout",      "--from",  "train_state_cycle1.h5",
+                                         "--amplitudes", "0.5%,1%", "--inertial-number",
+                                         "1e-2",         "--out",   "ro"};
+  const RunResult r = granmem_ok(args);
+  EXPECT_NE(r.err.find("3/3 runs done"), std::string::npos) << r.err;  // progress
+  EXPECT_NE(r.out.find("(0 runs reused)"), std::string::npos) << r.out;
+  const TrajectoryReader train(in_work("train.h5")),
+      at_training(in_work("ro") / "readout_train_state_cycle1_A2pct.h5");
+  ASSERT_EQ(at_training.frame_count(), 2u);
+  EXPECT_TRUE(same_positions(at_training.read_frame(0), train.read_frame(1)));
+  EXPECT_TRUE(same_positions(at_training.read_frame(1), train.read_frame(2)));
+
+  const Table t = read_columns(in_work("ro") / "readout.csv",
+                               {"state", "trained_cycles", "amplitude_pct", "cycle", "dr_d"});
+  EXPECT_EQ(t["amplitude_pct"].values, (std::vector<double>{0.5, 1, 2}));
+  EXPECT_EQ(t["trained_cycles"].values, (std::vector<double>{1, 1, 1}));
+  for (double dr : t["dr_d"].values)
+    EXPECT_GT(dr, 0);
+
+  const std::string table = read_file(in_work("ro") / "readout.csv");
+  const RunResult again = granmem_ok(args);
+  EXPECT_NE(again.out.find("(3 runs reused)"), std::string::npos) << again.out;
+  EXPECT_EQ(read_file(in_work("ro") / "readout.csv"), table);
+}
+
+TEST_F(Readout, BadInputIsRefusedInOneLineBeforeAnyRun) {
+  expect_clean_failure({"readout", "--from", "train.h5", "--amplitudes", "1%", "--out", "ro"},
+                       {"train.h5", "not a granmem checkpoint"});
+  expect_clean_failure(
+      {"readout", "--from", "train_state_cycle1.h5", "--amplitudes", "60%", "--out", "ro"},
+      {"60", "less than half the box"});
+  expect_clean_failure(
+      {"readout", "--from", "train_state_cycle1.h5", "--amplitudes", "0.1cm", "--out", "ro"},
+      {"--amplitudes", "percentages"});
+  expect_clean_failure(
+      {"readout", "--from", "train_state_cycle1.h5", "--amplitudes", "", "--out", "ro"},
+      {"no read-out amplitudes"});
+}
+
+}  // namespace
+}  // namespace granmem::testing

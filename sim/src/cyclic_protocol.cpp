@@ -109,7 +109,7 @@ void CyclicOptions::validate(double box_y, double dt) const {
     throw Error("samples per cycle and checkpoint interval must be zero or positive");
   }
   for (std::int64_t c : keep_states) {
-    if (c < 1) throw Error("kept state after cycle " + std::to_string(c) + ": cycles count from 1");
+    if (c < 0) throw Error("kept state after cycle " + std::to_string(c) + ": cycles count from 0");
   }
 }
 
@@ -207,11 +207,23 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
     if (!o.checkpoint.empty()) write_checkpoint(o.checkpoint, sim, state);
   };
 
+  // The state after the cycles just completed, if asked for (with the outputs so far).
+  auto keep_if_asked = [&] {
+    const auto& keep = o.keep_states;
+    if (std::find(keep.begin(), keep.end(), state.cycles_done) == keep.end()) return false;
+    save(false);
+    const std::filesystem::path kept = kept_state_path(o.out, state.cycles_done);
+    write_checkpoint(kept, sim, state);
+    summary.written.push_back(kept);
+    return true;
+  };
+
   if (fresh) {
     state.cycles_done = 0;
     state.step_in_cycle = 0;
     append(kEnd, 0);  // the prepared packing, before the first cycle
     end_of_cycle_observables(driven_wall_force(sim));
+    keep_if_asked();  // 0: the untrained packing, the read-out's reference
   }
 
   const auto clock_start = std::chrono::steady_clock::now();
@@ -270,16 +282,9 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
     const auto pending = state.pending.find("wall_force_full_compression");
     end_of_cycle_observables(pending != state.pending.end() ? pending->second : std::nan(""));
     report(true);
-    const bool keep = std::find(o.keep_states.begin(), o.keep_states.end(), state.cycles_done) !=
-                      o.keep_states.end();
-    if (keep || (o.checkpoint_every > 0 && state.cycles_done % o.checkpoint_every == 0 &&
-                 state.cycles_done < o.cycles)) {
+    if (!keep_if_asked() && o.checkpoint_every > 0 && state.cycles_done % o.checkpoint_every == 0 &&
+        state.cycles_done < o.cycles) {
       save(false);
-    }
-    if (keep) {
-      const std::filesystem::path kept = kept_state_path(o.out, state.cycles_done);
-      write_checkpoint(kept, sim, state);
-      summary.written.push_back(kept);
     }
   }
   save(true);

@@ -149,16 +149,17 @@ TEST_F(Restart, ResumedAtTheEndOfACycleWritesTheSameRunBitForBit) {
   EXPECT_EQ(read_trajectories(b.out).frames.size(), 4u);  // the packing, then 3 cycles
 }
 
-// States kept after cycles 1 and 2 of the run: a new protocol of one more cycle started
-// from the second is the run's third cycle, bit for bit (a read-out at the training
-// amplitude continues the training); --resume from the first continues the whole run.
+// States kept before the first cycle and after cycles 1 and 2 of the run: the first is
+// the prepared packing; a new protocol of one more cycle started from the last is the
+// run's third cycle, bit for bit (a read-out at the training amplitude continues the
+// training); --resume from the one after cycle 1 continues the whole run.
 TEST_F(Restart, AKeptStateStartsTheRestOfTheRunBitForBit) {
   Simulation whole = small_packing();
   const CyclicOptions a = whole_run(&whole);
 
   fs::create_directories(path("kept"));
   CyclicOptions b = cycles_into(path("kept"), 3);
-  b.keep_states = {1, 2};
+  b.keep_states = {0, 1, 2};
   {
     Simulation sim = small_packing();
     ProtocolState state;
@@ -176,6 +177,11 @@ TEST_F(Restart, AKeptStateStartsTheRestOfTheRunBitForBit) {
   run_cycles(from_2, next, fresh);
   expect_same_state(whole, from_2);
 
+  ProtocolState untrained;
+  const Simulation from_0 = read_checkpoint(kept_state_path(b.out, 0), &untrained);
+  EXPECT_EQ(untrained.cycles_done, 0);
+  expect_same_state(small_packing(), from_0);
+
   ProtocolState resumed;
   Simulation from_1 = read_checkpoint(kept_state_path(b.out, 1), &resumed);
   EXPECT_EQ(run_cycles(from_1, b, resumed).cycles_done, 3);
@@ -183,13 +189,13 @@ TEST_F(Restart, AKeptStateStartsTheRestOfTheRunBitForBit) {
   expect_same_state(whole, from_1);
 }
 
-TEST(KeptStates, CyclesBeforeTheFirstAreRefused) {
+TEST(KeptStates, NegativeCyclesAreRefused) {
   CyclicOptions o;
   o.drive.amplitude = 1e-3;
   o.drive.period = 0.02;
-  o.keep_states = {0};
+  o.keep_states = {-1};
   EXPECT_THROW(o.validate(0.02, 25e-6), Error);
-  o.keep_states = {1};
+  o.keep_states = {0};
   EXPECT_NO_THROW(o.validate(0.02, 25e-6));
 }
 

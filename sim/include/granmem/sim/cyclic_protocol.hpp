@@ -28,7 +28,8 @@ struct CyclicOptions {
   std::int64_t checkpoint_every = 0;              // cycles between checkpoints; 0: at the end only
   std::map<std::string, std::string> parameters;  // written into the outputs' /parameters
   // Cycles after which the full state is kept, as a checkpoint at
-  // kept_state_path(out, cycle): the trained states that a memory read-out starts from.
+  // kept_state_path(out, cycle): the trained states that a memory read-out starts from
+  // (0: the packing before the first cycle, the untrained reference).
   std::vector<std::int64_t> keep_states;
 
   // Throws Error for settings no run can use in a box of this depth along y with this step

@@ -17,6 +17,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/sim/checkpoint.hpp"
+#include "granmem/sim/ranks.hpp"
 #include "parse.hpp"
 #include "simulation_settings.hpp"
 
@@ -334,6 +335,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     const double best = std::stod(rounded);
     const FrictionRunSpec best_spec{best, d.seed};
     run_all({best_spec});
+    if (!mpi_ranks().root()) return;  // in an MPI job, rank 0 writes the results
     const fs::path best_path = friction_run_path(series.dir, best_spec);
     const TrajectoryReader best_run(best_path);
     const CycleObservables at_fit = cycle_observables(best_run, observe);

@@ -4,6 +4,7 @@
 #include "commands.hpp"
 #include "granmem/calibration/readout.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/sim/ranks.hpp"
 #include "parse.hpp"
 
 namespace granmem::app {
@@ -61,10 +62,13 @@ void add_readout(CLI::App& app) {
     o.sweep.pool.parallel = args->parallel;
     o.sweep.dir = args->out;
     o.bootstrap = args->bootstrap;
-    const ReadoutSummary s = readout(o, [](const ReadoutSweepProgress& p) {
+    const bool root = mpi_ranks().root();  // in an MPI job, rank 0 speaks
+    const ReadoutSummary s = readout(o, [root](const ReadoutSweepProgress& p) {
+      if (!root) return;
       std::cerr << "readout: " << p.done << "/" << p.runs << " runs done, "
                 << duration_text(p.seconds_left) << " left\n";
     });
+    if (!root) return;
     std::size_t reused = 0;
     for (const ReadoutRun& r : s.sweep.runs)
       reused += r.reused;

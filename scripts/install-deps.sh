@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libhdf5-dev hdf5-tools libcli11-dev libopencv-dev libceres-dev libtiff-dev
   libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libnanoflann-dev
   gnuplot-nox
+  libopenmpi-dev openmpi-bin
 )
 
 missing=()

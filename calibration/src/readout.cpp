@@ -9,6 +9,7 @@
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
+#include "granmem/sim/ranks.hpp"
 
 namespace granmem {
 namespace {
@@ -125,6 +126,7 @@ ReadoutSummary readout(const ReadoutOptions& o,
                        const std::function<void(const ReadoutSweepProgress&)>& progress) {
   ReadoutSummary s;
   s.sweep = run_readout_sweep(o.sweep, progress);
+  if (!mpi_ranks().root()) return s;  // in an MPI job, rank 0 reads every run and writes
   for (const ReadoutRun& run : s.sweep.runs) {
     const std::vector<ReadoutPoint> points = readout_points(run, o);
     s.points.insert(s.points.end(), points.begin(), points.end());

@@ -7,25 +7,34 @@
 #include <thread>
 #include <vector>
 
+#include "granmem/core/error.hpp"
+#include "granmem/sim/ranks.hpp"
+
 namespace granmem {
 
 RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
                         const std::function<void(std::size_t)>& run) {
-  const int cores = std::max(1, int(std::thread::hardware_concurrency()));
-  const int workers = int(
-      std::min<std::size_t>(count, std::size_t(options.parallel > 0 ? options.parallel : cores)));
+  const Ranks ranks = mpi_ranks();
+  mpi_barrier();  // every rank has planned the same runs before any run writes
+  std::vector<std::size_t> mine;
+  for (std::size_t k = std::size_t(ranks.rank); k < count; k += std::size_t(ranks.size))
+    mine.push_back(k);
+  const int cores =
+      std::max(1, int(std::thread::hardware_concurrency()) / std::max(1, ranks.on_node));
+  const int workers = int(std::min<std::size_t>(
+      mine.size(), std::size_t(options.parallel > 0 ? options.parallel : cores)));
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex failed;
   std::exception_ptr failure;
   auto work = [&] {
-    for (std::size_t k; (k = next++) < count;) {
+    for (std::size_t t; (t = next++) < mine.size();) {
       try {
-        run(k);
+        run(mine[t]);
         ++done;
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failed);
         if (!failure) failure = std::current_exception();
-        next = count;
+        next = mine.size();
       }
     }
   };
@@ -35,8 +44,10 @@ RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
   if (workers > 0) work();
   for (std::thread& t : pool)
     t.join();
+  const bool any_failed = mpi_any(failure != nullptr);  // every rank waits for every run
   if (failure) std::rethrow_exception(failure);
-  return {done.load(), workers};
+  if (any_failed) throw Error("run pool: a run failed on another rank (its error is in its log)");
+  return {done.load(), workers, ranks.size};
 }
 
 }  // namespace granmem

@@ -3,6 +3,7 @@
 // bit for bit; a second call reuses the finished runs; bad input is refused in one line.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 
 #include "granmem/core/trajectory_store.hpp"
@@ -56,6 +57,38 @@ TEST_F(Readout, AtTheTrainingAmplitudeItIsTheRunsNextCycleAndFinishedRunsAreReus
   EXPECT_NE(again.out.find("(3 runs reused)"), std::string::npos) << again.out;
   EXPECT_EQ(read_file(in_work("ro") / "readout.csv"), table);
 }
+
+#ifdef GRANMEM_MPIEXEC
+// On 2 MPI ranks (a -DGRANMEM_MPI=ON build): the runs are shared out, and every store and
+// the table are those of the single-process read-out, bit for bit.
+TEST_F(Readout, OnTwoMpiRanksItWritesTheSameRunsAndTableBitForBit) {
+  const std::vector<std::string> sweep = {"readout",      "--from",     "train_state_cycle1.h5",
+                                          "--amplitudes", "0.5%,1%",    "--inertial-number",
+                                          "1e-2",         "--parallel", "1"};
+  std::vector<std::string> one = sweep, two = sweep;
+  one.insert(one.end(), {"--out", "one"});
+  two.insert(two.end(), {"--out", "two"});
+  granmem_ok(one);
+  const std::string command =
+      "cd " + shell_quote(work().string()) + " && " + shell_quote(GRANMEM_MPIEXEC) +
+      " --allow-run-as-root --oversubscribe -np 2 " + shell_quote(GRANMEM_EXE);
+  std::string args;
+  for (const std::string& a : two)
+    args += " " + shell_quote(a);
+  ASSERT_EQ(std::system((command + args + " > mpi.out 2> mpi.err").c_str()), 0)
+      << read_file(in_work("mpi.err"));
+  const std::string said = read_file(in_work("mpi.out"));
+  EXPECT_EQ(said.find("read out"), said.rfind("read out")) << "rank 1 spoke too:\n" << said;
+  for (const char* a : {"0.5", "1", "2"}) {
+    const std::string name = std::string("readout_train_state_cycle1_A") + a + "pct.h5";
+    const TrajectoryReader x(in_work("one") / name), y(in_work("two") / name);
+    ASSERT_EQ(x.frame_count(), y.frame_count()) << name;
+    for (std::size_t t = 0; t < x.frame_count(); ++t)
+      EXPECT_TRUE(same_positions(x.read_frame(t), y.read_frame(t))) << name << " frame " << t;
+  }
+  EXPECT_EQ(read_file(in_work("one") / "readout.csv"), read_file(in_work("two") / "readout.csv"));
+}
+#endif
 
 TEST_F(Readout, BadInputIsRefusedInOneLineBeforeAnyRun) {
   expect_clean_failure({"readout", "--from", "train.h5", "--amplitudes", "1%", "--out", "ro"},

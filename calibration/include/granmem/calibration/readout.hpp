@@ -55,7 +55,9 @@ std::vector<ReadoutPoint> readout_points(const ReadoutRun& run, const ReadoutOpt
 // rot_single_d, rot_single_err_d, rot_full_d, rot_full_err_d, reversibility_d).
 Table readout_table(const std::vector<ReadoutPoint>& points);
 
-// Runs (or reuses) the sweep, computes every point and writes <dir>/readout.csv.
+// Runs (or reuses) the sweep, computes every point and writes <dir>/readout.csv. In an
+// MPI job every rank calls it and shares the runs; rank 0 alone computes the points and
+// writes the table (the other ranks return the sweep only).
 ReadoutSummary readout(const ReadoutOptions& options,
                        const std::function<void(const ReadoutSweepProgress&)>& progress = {});
 

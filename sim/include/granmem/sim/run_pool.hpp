@@ -9,18 +9,25 @@ namespace granmem {
 // read-out, the frictions and packings of a calibration's simulated twin. A run is a
 // whole simulation, so the runs, not the grains, are what is shared out.
 struct RunPoolOptions {
-  int parallel = 0;  // runs at once; 0: one per core
+  int parallel = 0;  // runs at once in this process; 0: one per core (shared by the ranks
+                     // of an MPI job on the same machine)
 };
 
 struct RunPoolSummary {
-  std::size_t runs = 0;  // runs done
+  std::size_t runs = 0;  // runs done by this process
   int workers = 0;       // threads that ran them
+  int ranks = 1;         // processes of the MPI job that shared the runs
 };
 
 // Calls run(k) for every k in [0, count), `parallel` at a time, each on a thread of its own
 // (a run sets its simulation to one thread). Runs are dealt in the order of k as workers
 // free up. The first exception thrown by a run stops the dealing; the runs under way are
 // finished, and the exception is rethrown.
+//
+// In an MPI job (ranks.hpp) every rank calls run_pool with the same runs; rank r does runs
+// r, r + size, ... and all return together once every run is done, so that rank 0 may then
+// read what every run wrote (to a shared file system). A run that fails on one rank makes
+// run_pool throw on every rank. A run's result does not depend on where it ran.
 RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
                         const std::function<void(std::size_t)>& run);
 

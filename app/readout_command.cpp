@@ -84,7 +84,14 @@ void add_readout(CLI::App& app) {
                 << std::setw(12) << p.dr << std::setw(12) << p.rot_single << std::setw(12)
                 << p.rot_full << "\n";
     }
-    std::cout << "wrote " << s.table.string() << "\n";
+    for (const StateSignature& m : s.signatures) {
+      std::cout << "state " << m.state << " (" << m.trained_cycles << " cycles at "
+                << m.training_amplitude * 100 << " %): dr dip " << m.dr_dip.depth << " +- "
+                << m.dr_dip.depth_error << ", dr / untrained " << m.dr_untrained.ratio << " +- "
+                << m.dr_untrained.error << ", rot1 exponents " << m.rot_single.below.exponent
+                << " below, " << m.rot_single.above.exponent << " above\n";
+    }
+    std::cout << "wrote " << s.table.string() << ", " << s.signature_table.string() << "\n";
   });
 }
 

@@ -35,8 +35,8 @@ PowerLawFit fit_power_law(const std::vector<double>& n, const std::vector<double
   }
   PowerLawFit fit;
   double steady = 0;
-  const bool held = options.steady_points > 0;
-  if (held) {
+  const bool held = options.steady_points > 0 || options.pure;
+  if (options.steady_points > 0 && !options.pure) {
     if (use.size() < options.steady_points + 4) {
       throw Error("power-law fit: " + std::to_string(use.size()) + " cycles, need " +
                   std::to_string(options.steady_points + 4) + " with a steady state of the last " +

@@ -1,6 +1,8 @@
 #include "granmem/calibration/readout.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -122,6 +124,107 @@ Table readout_table(const std::vector<ReadoutPoint>& points) {
   return t;
 }
 
+namespace {
+
+// A state's curve of one quantity over its first read-out cycle, amplitudes ascending.
+ReadoutCurve curve_of(const std::vector<ReadoutPoint>& points, std::size_t state,
+                      double ReadoutPoint::*value, double ReadoutPoint::*error) {
+  ReadoutCurve c;
+  for (const ReadoutPoint& p : points) {
+    if (p.state != state || p.cycle != 1 || !(p.amplitude > 0)) continue;
+    c.amplitude.push_back(p.amplitude);
+    c.value.push_back(p.*value);
+    c.error.push_back(p.*error);
+  }
+  return c;
+}
+
+bool between_others(const ReadoutCurve& c, double a) {
+  for (std::size_t k = 1; k + 1 < c.amplitude.size(); ++k) {
+    if (std::abs(c.amplitude[k] - a) <= 1e-9 * a) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::vector<StateSignature> readout_signatures(const std::vector<ReadoutPoint>& points) {
+  std::vector<StateSignature> out;
+  std::vector<std::size_t> untrained;
+  for (const ReadoutPoint& p : points) {
+    if (p.trained_cycles == 0 && p.cycle == 1 && p.amplitude > 0 &&
+        std::find(untrained.begin(), untrained.end(), p.state) == untrained.end()) {
+      untrained.push_back(p.state);
+    }
+  }
+  for (const ReadoutPoint& p : points) {
+    if (p.cycle != 1 || !std::isfinite(p.training_amplitude)) continue;
+    if (!out.empty() && out.back().state == p.state) continue;
+    const double a = p.training_amplitude;
+    const ReadoutCurve dr = curve_of(points, p.state, &ReadoutPoint::dr, &ReadoutPoint::dr_error);
+    if (!between_others(dr, a)) continue;
+    StateSignature s;
+    s.state = p.state;
+    s.trained_cycles = p.trained_cycles;
+    s.training_amplitude = a;
+    s.dr_dip = interpolation_dip(dr, a);
+    if (!untrained.empty()) {
+      const ReadoutCurve base =
+          curve_of(points, untrained.front(), &ReadoutPoint::dr, &ReadoutPoint::dr_error);
+      if (between_others(base, a)) s.dr_untrained = trained_ratio(dr, base, a);
+    }
+    s.rot_single = readout_exponents(
+        curve_of(points, p.state, &ReadoutPoint::rot_single, &ReadoutPoint::rot_single_error), a);
+    s.rot_full = readout_exponents(
+        curve_of(points, p.state, &ReadoutPoint::rot_full, &ReadoutPoint::rot_full_error), a);
+    out.push_back(s);
+  }
+  return out;
+}
+
+Table signature_table(const std::vector<StateSignature>& signatures) {
+  Table t;
+  Column& state = t.add("state", "", true);
+  Column& trained = t.add("trained_cycles", "", true);
+  Column& training = t.add("training_amplitude_pct", "%");
+  Column& dip = t.add("dr_dip");
+  Column& dip_err = t.add("dr_dip_err");
+  Column& ratio = t.add("dr_over_untrained");
+  Column& ratio_err = t.add("dr_over_untrained_err");
+  auto exponent = [](const PowerLawFit& f, bool value) {
+    if (!f.converged) return std::nan("");
+    return value ? f.exponent : f.exponent_sigma;
+  };
+  std::vector<std::pair<Column*, std::function<double(const StateSignature&)>>> fits;
+  for (const char* q : {"rot_single", "rot_full"}) {
+    const bool single = std::string(q) == "rot_single";
+    for (const char* side : {"below", "above"}) {
+      const bool below = std::string(side) == "below";
+      auto fit = [single, below](const StateSignature& s) -> const PowerLawFit& {
+        const ReadoutExponents& e = single ? s.rot_single : s.rot_full;
+        return below ? e.below : e.above;
+      };
+      const std::string name = std::string(q) + "_exp_" + side;
+      fits.push_back(
+          {&t.add(name), [=](const StateSignature& s) { return exponent(fit(s), true); }});
+      fits.push_back({&t.add(name + "_err"),
+                      [=](const StateSignature& s) { return exponent(fit(s), false); }});
+    }
+  }
+  for (const StateSignature& s : signatures) {
+    state.values.push_back(double(s.state));
+    trained.values.push_back(double(s.trained_cycles));
+    training.values.push_back(s.training_amplitude * 100);
+    dip.values.push_back(s.dr_dip.depth);
+    dip_err.values.push_back(s.dr_dip.depth_error);
+    ratio.values.push_back(s.dr_untrained.ratio);
+    ratio_err.values.push_back(s.dr_untrained.error);
+    for (auto& [column, get] : fits)
+      column->values.push_back(get(s));
+  }
+  return t;
+}
+
 ReadoutSummary readout(const ReadoutOptions& o,
                        const std::function<void(const ReadoutSweepProgress&)>& progress) {
   ReadoutSummary s;
@@ -140,6 +243,14 @@ ReadoutSummary readout(const ReadoutOptions& o,
   for (std::size_t k = 0; k < o.sweep.states.size(); ++k)
     comment.push_back("state " + std::to_string(k) + ": " + o.sweep.states[k].string());
   write_csv(readout_table(s.points), s.table, comment);
+  s.signatures = readout_signatures(s.points);
+  s.signature_table = o.sweep.dir / "memory.csv";
+  comment[0] =
+      "granmem readout: memory signature of each state's first read-out cycle: dip of dr at "
+      "the training amplitude below its neighbours' power law (1 - value / interpolated), dr "
+      "over the untrained state's, power-law exponents of the rotations at and below / at and "
+      "above it (Ceres fit, standard errors)";
+  write_csv(signature_table(s.signatures), s.signature_table, comment);
   return s;
 }
 

@@ -3,6 +3,7 @@
 // bit for bit; a second call reuses the finished runs; bad input is refused in one line.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 
@@ -33,11 +34,11 @@ bool same_positions(const Frame& a, const Frame& b) {
 }
 
 TEST_F(Readout, AtTheTrainingAmplitudeItIsTheRunsNextCycleAndFinishedRunsAreReused) {
-  const std::vector<std::string> args = {"readout",      "--from",  "train_state_cycle1.h5",
-                                         "--amplitudes", "0.5%,1%", "--inertial-number",
-                                         "1e-2",         "--out",   "ro"};
+  const std::vector<std::string> args = {"readout",      "--from",     "train_state_cycle1.h5",
+                                         "--amplitudes", "0.5%,1%,3%", "--inertial-number",
+                                         "1e-2",         "--out",      "ro"};
   const RunResult r = granmem_ok(args);
-  EXPECT_NE(r.err.find("3/3 runs done"), std::string::npos) << r.err;  // progress
+  EXPECT_NE(r.err.find("4/4 runs done"), std::string::npos) << r.err;  // progress
   EXPECT_NE(r.out.find("(0 runs reused)"), std::string::npos) << r.out;
   const TrajectoryReader train(in_work("train.h5")),
       at_training(in_work("ro") / "readout_train_state_cycle1_A2pct.h5");
@@ -47,14 +48,22 @@ TEST_F(Readout, AtTheTrainingAmplitudeItIsTheRunsNextCycleAndFinishedRunsAreReus
 
   const Table t = read_columns(in_work("ro") / "readout.csv",
                                {"state", "trained_cycles", "amplitude_pct", "cycle", "dr_d"});
-  EXPECT_EQ(t["amplitude_pct"].values, (std::vector<double>{0.5, 1, 2}));
-  EXPECT_EQ(t["trained_cycles"].values, (std::vector<double>{1, 1, 1}));
+  EXPECT_EQ(t["amplitude_pct"].values, (std::vector<double>{0.5, 1, 2, 3}));
+  EXPECT_EQ(t["trained_cycles"].values, (std::vector<double>{1, 1, 1, 1}));
+  // The signature of the state, whose training amplitude (2 %) lies inside the sweep.
+  const Table m = read_columns(
+      in_work("ro") / "memory.csv",
+      {"trained_cycles", "training_amplitude_pct", "dr_dip", "dr_dip_err", "rot_single_exp_below"});
+  ASSERT_EQ(m.rows(), 1u);
+  EXPECT_EQ(m["training_amplitude_pct"].values[0], 2);
+  EXPECT_TRUE(std::isfinite(m["dr_dip"].values[0]));
+  EXPECT_GT(m["dr_dip_err"].values[0], 0);
   for (double dr : t["dr_d"].values)
     EXPECT_GT(dr, 0);
 
   const std::string table = read_file(in_work("ro") / "readout.csv");
   const RunResult again = granmem_ok(args);
-  EXPECT_NE(again.out.find("(3 runs reused)"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("(4 runs reused)"), std::string::npos) << again.out;
   EXPECT_EQ(read_file(in_work("ro") / "readout.csv"), table);
 }
 

@@ -14,6 +14,8 @@ struct PowerLawOptions {
   // The steady state m_inf: fitted with a and b when 0; else held at the mean of the last
   // this many points (the paper's choice: its last 20 cycles), which are then not fitted.
   std::size_t steady_points = 0;
+  // Hold m_inf at 0: a pure power law a n^(-b) (the read-out's rotations against 1/A').
+  bool pure = false;
   // Cauchy loss: residuals beyond this many standard errors (in the points' unit when no
   // errors are given) are down-weighted, so that a few cycles with a collective slip do not
   // pull the exponent.

@@ -1,11 +1,13 @@
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <vector>
 
+#include "granmem/calibration/memory_signature.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/rotation/grain_motion.hpp"
 #include "granmem/sim/readout_sweep.hpp"
@@ -40,11 +42,33 @@ struct ReadoutPoint {
   double reversibility = 0;                     // mean |r_c - r_(c-1)|: NaN for the first cycle
 };
 
+// The memory signature of one state's read-out (its first read-out cycle), as numbers:
+// the dip of the displacement at the training amplitude below its neighbours, the
+// displacement there over the untrained packing's (a state of 0 trained cycles in the same
+// sweep; NaN without one), and the power laws of the rotations below and above it.
+struct StateSignature {
+  std::size_t state = 0;
+  std::int64_t trained_cycles = 0;
+  double training_amplitude = 0;
+  MemoryDip dr_dip;
+  TrainedRatio dr_untrained{std::nan(""), std::nan("")};
+  ReadoutExponents rot_single, rot_full;
+};
+
+// The signature of every state whose sweep holds its training amplitude between two others.
+std::vector<StateSignature> readout_signatures(const std::vector<ReadoutPoint>& points);
+// Columns: state, trained_cycles, training_amplitude_pct, dr_dip, dr_dip_err,
+// dr_over_untrained, dr_over_untrained_err, then for rot_single and rot_full: _exp_below,
+// _exp_below_err, _exp_above, _exp_above_err (NaN where a side has under four points).
+Table signature_table(const std::vector<StateSignature>& signatures);
+
 struct ReadoutSummary {
   ReadoutSweepSummary sweep;
   std::vector<ReadoutPoint> points;  // run by run, cycles ascending
-  double diameter = 0;               // m, the length unit of the points
-  std::filesystem::path table;       // <dir>/readout.csv
+  std::vector<StateSignature> signatures;
+  double diameter = 0;                    // m, the length unit of the points
+  std::filesystem::path table;            // <dir>/readout.csv
+  std::filesystem::path signature_table;  // <dir>/memory.csv
 };
 
 // The points of one finished read-out run (its end-of-cycle store).
@@ -55,7 +79,8 @@ std::vector<ReadoutPoint> readout_points(const ReadoutRun& run, const ReadoutOpt
 // rot_single_d, rot_single_err_d, rot_full_d, rot_full_err_d, reversibility_d).
 Table readout_table(const std::vector<ReadoutPoint>& points);
 
-// Runs (or reuses) the sweep, computes every point and writes <dir>/readout.csv. In an
+// Runs (or reuses) the sweep, computes every point and signature and writes
+// <dir>/readout.csv and <dir>/memory.csv. In an
 // MPI job every rank calls it and shares the runs; rank 0 alone computes the points and
 // writes the table (the other ranks return the sweep only).
 ReadoutSummary readout(const ReadoutOptions& options,

@@ -16,6 +16,7 @@
 #include "granmem/sim/cyclic_protocol.hpp"
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/quasi_static.hpp"
+#include "granmem/sim/run_settings.hpp"
 #include "parse.hpp"
 #include "simulation_settings.hpp"
 
@@ -48,6 +49,15 @@ void check_outputs(const std::vector<std::filesystem::path>& outputs,
     }
     seen.push_back(full);
   }
+}
+
+// The options set on the command line or in the config.
+std::set<std::string> explicitly_given(const std::map<std::string, CLI::Option*>& options) {
+  std::set<std::string> given;
+  for (const auto& [name, option] : options) {
+    if (option->count()) given.insert(name);
+  }
+  return given;
 }
 
 }  // namespace
@@ -85,20 +95,8 @@ SimulateSettings add_simulate(CLI::App& app) {
     if (!resume->empty()) {
       sim.emplace(read_checkpoint(*resume, &state));
       // The run goes on with the settings it started with; more cycles may be asked for.
-      for (const auto& [key, value] : state.settings) {
-        const bool may_change = key == "cycles" || key == "checkpoint-every";
-        const auto option = given.find(key);
-        if (option != given.end() && option->second->count() && args->value.at(key) != value) {
-          if (!may_change) {
-            throw Error("--" + key + " " + args->value.at(key) + ": a resumed run keeps its " +
-                        "settings (" + value + "); only --cycles and --checkpoint-every change");
-          }
-          v[key] = args->value.at(key);
-          state.settings[key] = v[key];
-        } else {
-          v[key] = value;
-        }
-      }
+      v = resumed_settings(state.settings, args->value, explicitly_given(given),
+                           {"checkpoint-every", "cycles"});
       std::cerr << "resuming " << *resume << " after cycle " << state.cycles_done
                 << (state.step_in_cycle ? " (+" + std::to_string(state.step_in_cycle) + " steps)"
                                         : std::string())
@@ -112,25 +110,12 @@ SimulateSettings add_simulate(CLI::App& app) {
                     ": written in the middle of a cycle; a new protocol starts "
                     "between cycles (--resume finishes that run)");
       }
-      // The packing and its physics are the checkpoint's; the protocol is new.
-      for (std::size_t k = 0; k < kPackingOptionCount; ++k) {
-        const char* name = kPackingOptions[k];
-        const auto it = trained.settings.find(name);
-        if (it == trained.settings.end() && std::string(name) == "lid-pressure") {
-          continue;  // written before the option existed: its lid mass is explicit
-        }
-        if (it == trained.settings.end()) {
-          throw Error(*start_from + ": has no setting '" + name +
-                      "' (was it written by granmem simulate?)");
-        }
-        const std::string& theirs = it->second;
-        if (given.at(name)->count() && args->value.at(name) != theirs) {
-          throw Error(std::string("--") + name + " " + args->value.at(name) +
-                      ": with --start-from the packing and its physics are the checkpoint's (" +
-                      theirs + ")");
-        }
-        v[name] = theirs;
-      }
+      // The packing and its physics are the checkpoint's; the protocol is new. A checkpoint
+      // written before --lid-pressure existed has an explicit lid mass.
+      v = started_from_settings(
+          trained.settings, args->value, explicitly_given(given),
+          std::vector<std::string>(kPackingOptions, kPackingOptions + kPackingOptionCount),
+          {"lid-pressure"}, *start_from);
       v["start-from"] = *start_from;
       state.settings = v;
       std::cerr << "starting from " << *start_from << " (after cycle " << trained.cycles_done

@@ -141,9 +141,12 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                         "mean rotational displacement per cycle - steady state [d]",
                         "Rotations: relaxation to the steady state"));
   }
-  for (const Relaxation& r : trans) {
-    std::cout << "  relaxation of " << r.label << ": exponent " << r.fit.exponent << " ["
-              << r.fit.exponent_ci95[0] << ", " << r.fit.exponent_ci95[1] << "]\n";
+  for (const auto* set : {&trans, &rot}) {
+    for (const Relaxation& r : *set) {
+      std::cout << "  relaxation of " << (set == &rot ? "the rotations of " : "") << r.label
+                << ": exponent " << r.fit.exponent << " [" << r.fit.exponent_ci95[0] << ", "
+                << r.fit.exponent_ci95[1] << "]\n";
+    }
   }
 
   // Fig. 1: displacement fields, y-z projection.

@@ -3,6 +3,7 @@
 # scripts/memory_study.sh (DIR/readout_mu<M>_seed<S>/{readout,memory}.csv).
 #
 #   scripts/memory_report.sh [--runs DIR] [--out DIR] [--name readout] [--title TEXT]
+#                            [--granmem BIN] [--last 20]
 #
 # Writes in --out (default docs/data/memory):
 #   <name>_all.csv       every read-out point (first read-out cycle): mu_s, seed, trained
@@ -14,6 +15,10 @@
 #   <name>.png, <name>.svg   translations (top) and single-axis rotations (bottom) against
 #                        A', one column per mu_s, one curve per training length, the
 #                        training amplitude dashed (the paper's Fig. 4)
+#   training.csv         the trainings themselves (DIR/mu<M>_seed<S>.h5, `granmem compare`
+#                        of seed 1 and seed 2 of each mu_s, drift removed): mean end-of-cycle
+#                        displacement and single-axis rotation over the last --last cycles,
+#                        KS distance between the seeds, relaxation exponents (Figs 2a, 3)
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,13 +26,17 @@ runs="$root/out/memory"
 out="$root/docs/data/memory"
 name=readout
 title="granmem read-out"
+granmem="$root/build/app/granmem"
+last=20
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --runs) runs="$2"; shift ;;
     --out) out="$2"; shift ;;
     --name) name="$2"; shift ;;
     --title) title="$2"; shift ;;
-    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
+    --granmem) granmem="$2"; shift ;;
+    --last) last="$2"; shift ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "memory_report.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -123,4 +132,23 @@ GP
 }
 plot 'set terminal pngcairo size 1500,900 font ",10"' "$out/$name.png"
 plot 'set terminal svg size 1500,900 font "Arial,10"' "$out/$name.svg"
-echo "wrote $out/${name}_all.csv, ${name}_curves.csv, ${name}_signature_all.csv, ${name}_signature.csv, $name.png, $name.svg"
+# The trainings: seed 1 against seed 2 of each friction over the last cycles.
+echo "mu_s,cycles,window,mean_dr_seed1_d,mean_dr_seed2_d,ks_dr,mean_rot_seed1_d,mean_rot_seed2_d,ks_rot,relax_exp_dr_seed1,relax_exp_dr_seed2,relax_exp_rot_seed1,relax_exp_rot_seed2" > "$out/training.csv"
+for m in $mus; do
+  a="$runs/mu${m}_seed1.h5" b="$runs/mu${m}_seed2.h5"
+  [[ -s $a && -s $b ]] || continue
+  cycles=$(h5dump -H -d /particles/grains/position/step "$a" | awk -F'[()]' '/DATASPACE/ { print $2 - 1; exit }')
+  window="$((cycles - last + 1)):$cycles"
+  said=$("$granmem" compare "$a" "$b" --window "$window" --out "$runs/compare_mu$m" \
+    --label-a "mu_s $m seed 1" --label-b "mu_s $m seed 2" 2>&1)
+  exps=$(echo "$said" | awk '/relaxation of/ { printf ",%s", $(NF - 2) }')
+  awk -F, -v m="$m" -v c="$cycles" -v w="$window" -v e="$exps" '
+    /^#/ || /^quantity/ { next }
+    { mean1[$1] = $4; mean2[$1] = $5; ks[$1] = $8 }
+    END { n = split(substr(e, 2), x, ",")
+          printf "%s,%s,%s,%s,%s,%s,%s,%s,%s", m, c, w, mean1[1], mean2[1], ks[1], mean1[2], mean2[2], ks[2]
+          for (k = 1; k <= 4; k++) printf ",%s", (k <= n ? x[k] : "nan"); print "" }' \
+    "$runs/compare_mu$m/distances.csv" >> "$out/training.csv"
+done
+
+echo "wrote $out/${name}_all.csv, ${name}_curves.csv, ${name}_signature_all.csv, ${name}_signature.csv, $name.png, $name.svg, training.csv"

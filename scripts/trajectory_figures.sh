@@ -14,7 +14,9 @@
 #                                 [--seed 1] [--cycle 200] [--samples 100] [--group 20]
 #
 # Writes DIR/trajectories_mu<M>.h5 (+ _in_cycle.h5) under --runs, and trajectories_group.csv,
-# trajectories_axis.csv, trajectories.png/.svg under --out (default docs/data/memory).
+# trajectories_axis.csv, trajectories_loops.csv (each cycle's loop of the group's mean path:
+# enclosed area, length, distance from its end to its start, in d), trajectories.png/.svg
+# under --out (default docs/data/memory).
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -44,6 +46,7 @@ done
 mkdir -p "$out"
 echo "mu_s,sample,cycle_fraction,dy_d,dz_d" > "$out/trajectories_group.csv"
 echo "mu_s,grain,sample,cycle_fraction,ax,ay,az,u_deg,v_deg" > "$out/trajectories_axis.csv"
+echo "mu_s,cycle,loop_area_d2,path_length_d,return_distance_d" > "$out/trajectories_loops.csv"
 
 for m in $mus; do
   state="$runs/mu${m}_seed${seed}_state_cycle$cycle.h5"
@@ -60,7 +63,7 @@ for m in $mus; do
   # One awk over the start (end-of-cycle frame 0) and the samples: the group, its mean path,
   # and its most-turning grain's axis.
   awk -v m="$m" -v samples="$samples" -v group="$group" -v gout="$out/trajectories_group.csv" \
-      -v aout="$out/trajectories_axis.csv" '
+      -v aout="$out/trajectories_axis.csv" -v lout="$out/trajectories_loops.csv" '
     FNR == 1 { file++; frame = -1 }
     /^ITEM: TIMESTEP/ { frame++; next }
     /^ITEM: ATOMS/ { atoms = 1; next }
@@ -76,9 +79,18 @@ for m in $mus; do
       for (i in chosen) { t = 0
         for (f = 0; f <= last; f++) { c = ax[f, i] * a0x[i] + ay[f, i] * a0y[i] + az[f, i] * a0z[i]; c = c < 0 ? -c : c; if (1 - c > t) t = 1 - c }
         if (turn_best == "" || t > turn) { turn = t; turn_best = i } }
+      py = 0; pz = 0  # the group mean path, from the start
       for (f = 0; f <= last; f++) { sy = 0; sz = 0
         for (i in chosen) { sy += y[f, i] - y0[i]; sz += z[f, i] - z0[i] }
-        printf "%s,%d,%.4f,%.6g,%.6g\n", m, f + 1, (f + 1) / samples, sy / group / d, sz / group / d >> gout
+        gy = sy / group / d; gz = sz / group / d
+        printf "%s,%d,%.4f,%.6g,%.6g\n", m, f + 1, (f + 1) / samples, gy, gz >> gout
+        # The loop of each cycle: its enclosed area (shoelace, closed from its end back to its
+        # start), length, and how far its end is from its start.
+        if (f % samples == 0) { cy = py; cz = pz; area = 0; plen = 0 }
+        area += py * gz - gy * pz; plen += sqrt((gy - py) ^ 2 + (gz - pz) ^ 2); py = gy; pz = gz
+        if ((f + 1) % samples == 0) {
+          area += py * cz - cy * pz
+          printf "%s,%d,%.4g,%.4g,%.4g\n", m, (f + 1) / samples, (area < 0 ? -area : area) / 2, plen, sqrt((py - cy) ^ 2 + (pz - cz) ^ 2) >> lout }
         # The unsigned axis: the sign that keeps it near its start.
         i = turn_best; s = ax[f, i] * a0x[i] + ay[f, i] * a0y[i] + az[f, i] * a0z[i] < 0 ? -1 : 1
         bx = s * ax[f, i]; by = s * ay[f, i]; bz = s * az[f, i]
@@ -114,7 +126,7 @@ do for [k = 1:words(mus)] {
   mu = word(mus, k)
   set title sprintf("mu_s = %s: cavity axis of the group's most turning grain", mu)
   set xlabel "tilt along a0 x z (deg)"; set ylabel "tilt along a0 x (a0 x z) (deg)"
-  set size ratio -1
+  set size square
   plot "$out/trajectories_axis.csv" using (\$1 == real(mu) ? \$8 : 1/0):9:4 with lines lw 2 lc palette notitle
 }
 unset multiplot

@@ -65,7 +65,7 @@ gather() {  # file-in-each-readout-dir, columns..., filter on cycle (yes/no)
 gather readout.csv yes trained_cycles amplitude_pct dr_d dr_err_d msd_d2 msd_err_d2 \
   rot_single_d rot_single_err_d rot_full_d rot_full_err_d > "$out/${name}_all.csv"
 gather memory.csv no trained_cycles training_amplitude_pct dr_dip dr_dip_err dr_over_untrained \
-  dr_over_untrained_err rot_single_exp_below rot_single_exp_below_err rot_single_exp_above \
+  dr_over_untrained_err rot_single_dip rot_single_dip_err rot_single_exp_below rot_single_exp_below_err rot_single_exp_above \
   rot_single_exp_above_err > "$out/${name}_signature_all.csv"
 [[ $(wc -l < "$out/${name}_all.csv") -gt 1 ]] || { echo "memory_report.sh: no read-outs in $runs" >&2; exit 1; }
 

@@ -173,8 +173,10 @@ std::vector<StateSignature> readout_signatures(const std::vector<ReadoutPoint>& 
           curve_of(points, untrained.front(), &ReadoutPoint::dr, &ReadoutPoint::dr_error);
       if (between_others(base, a)) s.dr_untrained = trained_ratio(dr, base, a);
     }
-    s.rot_single = readout_exponents(
-        curve_of(points, p.state, &ReadoutPoint::rot_single, &ReadoutPoint::rot_single_error), a);
+    const ReadoutCurve rot =
+        curve_of(points, p.state, &ReadoutPoint::rot_single, &ReadoutPoint::rot_single_error);
+    s.rot_single_dip = interpolation_dip(rot, a);
+    s.rot_single = readout_exponents(rot, a);
     s.rot_full = readout_exponents(
         curve_of(points, p.state, &ReadoutPoint::rot_full, &ReadoutPoint::rot_full_error), a);
     out.push_back(s);
@@ -191,6 +193,8 @@ Table signature_table(const std::vector<StateSignature>& signatures) {
   Column& dip_err = t.add("dr_dip_err");
   Column& ratio = t.add("dr_over_untrained");
   Column& ratio_err = t.add("dr_over_untrained_err");
+  Column& rot_dip = t.add("rot_single_dip");
+  Column& rot_dip_err = t.add("rot_single_dip_err");
   auto exponent = [](const PowerLawFit& f, bool value) {
     if (!f.converged) return std::nan("");
     return value ? f.exponent : f.exponent_sigma;
@@ -219,6 +223,8 @@ Table signature_table(const std::vector<StateSignature>& signatures) {
     dip_err.values.push_back(s.dr_dip.depth_error);
     ratio.values.push_back(s.dr_untrained.ratio);
     ratio_err.values.push_back(s.dr_untrained.error);
+    rot_dip.values.push_back(s.rot_single_dip.depth);
+    rot_dip_err.values.push_back(s.rot_single_dip.depth_error);
     for (auto& [column, get] : fits)
       column->values.push_back(get(s));
   }
@@ -248,7 +254,8 @@ ReadoutSummary readout(const ReadoutOptions& o,
   comment[0] =
       "granmem readout: memory signature of each state's first read-out cycle: dip of dr at "
       "the training amplitude below its neighbours' power law (1 - value / interpolated), dr "
-      "over the untrained state's, power-law exponents of the rotations at and below / at and "
+      "over the untrained state's, the same dip of the single-axis rotation, power-law exponents "
+      "of the rotations at and below / at and "
       "above it (Ceres fit, standard errors)";
   write_csv(signature_table(s.signatures), s.signature_table, comment);
   return s;

@@ -43,14 +43,15 @@ struct ReadoutPoint {
 };
 
 // The memory signature of one state's read-out (its first read-out cycle), as numbers:
-// the dip of the displacement at the training amplitude below its neighbours, the
+// the dip of the displacement (and of the single-axis rotation) at the training amplitude
+// below its neighbours, the
 // displacement there over the untrained packing's (a state of 0 trained cycles in the same
 // sweep; NaN without one), and the power laws of the rotations below and above it.
 struct StateSignature {
   std::size_t state = 0;
   std::int64_t trained_cycles = 0;
   double training_amplitude = 0;
-  MemoryDip dr_dip;
+  MemoryDip dr_dip, rot_single_dip;
   TrainedRatio dr_untrained{std::nan(""), std::nan("")};
   ReadoutExponents rot_single, rot_full;
 };
@@ -58,7 +59,8 @@ struct StateSignature {
 // The signature of every state whose sweep holds its training amplitude between two others.
 std::vector<StateSignature> readout_signatures(const std::vector<ReadoutPoint>& points);
 // Columns: state, trained_cycles, training_amplitude_pct, dr_dip, dr_dip_err,
-// dr_over_untrained, dr_over_untrained_err, then for rot_single and rot_full: _exp_below,
+// dr_over_untrained, dr_over_untrained_err, rot_single_dip, rot_single_dip_err, then for
+// rot_single and rot_full: _exp_below,
 // _exp_below_err, _exp_above, _exp_above_err (NaN where a side has under four points).
 Table signature_table(const std::vector<StateSignature>& signatures);
 

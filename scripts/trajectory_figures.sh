@@ -119,7 +119,7 @@ do for [k = 1:words(mus)] {
   mu = word(mus, k)
   set title sprintf("mu_s = %s: mean path of $group shear-zone grains", mu)
   set xlabel "y displacement (d)"; set ylabel "z displacement (d)"
-  set size ratio -1
+  set size square
   plot "$out/trajectories_group.csv" using (\$1 == real(mu) ? \$4 : 1/0):5:3 with lines lw 2 lc palette notitle
 }
 do for [k = 1:words(mus)] {

@@ -15,7 +15,7 @@
 #   <name>.png, <name>.svg   translations (top) and single-axis rotations (bottom) against
 #                        A', one column per mu_s, one curve per training length, the
 #                        training amplitude dashed (the paper's Fig. 4)
-#   training.csv         the trainings themselves (DIR/mu<M>_seed<S>.h5, `granmem compare`
+#   <name>_training.csv  the trainings themselves (DIR/mu<M>_seed<S>.h5, `granmem compare`
 #                        of seed 1 and seed 2 of each mu_s, drift removed): mean end-of-cycle
 #                        displacement and single-axis rotation over the last --last cycles,
 #                        KS distance between the seeds, relaxation exponents (Figs 2a, 3)
@@ -133,7 +133,7 @@ GP
 plot 'set terminal pngcairo size 1500,900 font ",10"' "$out/$name.png"
 plot 'set terminal svg size 1500,900 font "Arial,10"' "$out/$name.svg"
 # The trainings: seed 1 against seed 2 of each friction over the last cycles.
-echo "mu_s,cycles,window,mean_dr_seed1_d,mean_dr_seed2_d,ks_dr,mean_rot_seed1_d,mean_rot_seed2_d,ks_rot,relax_exp_dr_seed1,relax_exp_dr_seed2,relax_exp_rot_seed1,relax_exp_rot_seed2" > "$out/training.csv"
+echo "mu_s,cycles,window,mean_dr_seed1_d,mean_dr_seed2_d,ks_dr,mean_rot_seed1_d,mean_rot_seed2_d,ks_rot,relax_exp_dr_seed1,relax_exp_dr_seed2,relax_exp_rot_seed1,relax_exp_rot_seed2" > "$out/${name}_training.csv"
 for m in $mus; do
   a="$runs/mu${m}_seed1.h5" b="$runs/mu${m}_seed2.h5"
   [[ -s $a && -s $b ]] || continue
@@ -148,7 +148,7 @@ for m in $mus; do
     END { n = split(substr(e, 2), x, ",")
           printf "%s,%s,%s,%s,%s,%s,%s,%s,%s", m, c, w, mean1[1], mean2[1], ks[1], mean1[2], mean2[2], ks[2]
           for (k = 1; k <= 4; k++) printf ",%s", (k <= n ? x[k] : "nan"); print "" }' \
-    "$runs/compare_mu$m/distances.csv" >> "$out/training.csv"
+    "$runs/compare_mu$m/distances.csv" >> "$out/${name}_training.csv"
 done
 
-echo "wrote $out/${name}_all.csv, ${name}_curves.csv, ${name}_signature_all.csv, ${name}_signature.csv, $name.png, $name.svg, training.csv"
+echo "wrote $out/${name}_all.csv, ${name}_curves.csv, ${name}_signature_all.csv, ${name}_signature.csv, $name.png, $name.svg, ${name}_training.csv"

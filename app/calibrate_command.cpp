@@ -287,14 +287,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
 
     // Runs already in DIR with the same settings are reused: a stopped calibration goes on.
     auto finished = [&](const FrictionRunSpec& run) {
-      const fs::path p = friction_run_path(series.dir, run);
-      if (!fs::exists(p)) return false;
-      const TrajectoryReader r(p);
-      for (const auto& [key, value] : series.protocol.parameters) {
-        const auto it = r.header().parameters.find(key);
-        if (it == r.header().parameters.end() || it->second != value) return false;
-      }
-      return r.steps().back() >= series.protocol.cycles;
+      return finished_run(friction_run_path(series.dir, run), series.protocol.parameters,
+                          series.protocol.cycles);
     };
     auto run_all = [&](const std::vector<FrictionRunSpec>& specs) {
       std::vector<FrictionRunSpec> todo;

@@ -20,6 +20,18 @@ std::filesystem::path in_cycle_path(const std::filesystem::path& out) {
   return out.parent_path() / (out.stem().string() + "_in_cycle" + out.extension().string());
 }
 
+bool finished_run(const std::filesystem::path& out,
+                  const std::map<std::string, std::string>& parameters, std::int64_t cycles) {
+  if (!std::filesystem::exists(out)) return false;
+  const TrajectoryReader run(out);
+  const auto& have = run.header().parameters;
+  for (const auto& [key, value] : parameters) {
+    const auto it = have.find(key);
+    if (it == have.end() || it->second != value) return false;
+  }
+  return !run.steps().empty() && run.steps().back() >= cycles;
+}
+
 std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle) {
   return out.parent_path() / (out.stem().string() + "_state_cycle" + std::to_string(cycle) + ".h5");
 }

@@ -10,7 +10,6 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
-#include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
@@ -106,24 +105,6 @@ std::map<std::string, std::string> run_parameters(const ReadoutSweepOptions& o,
           {"readout/inertial_number", exact_text(o.inertial_number)}};
 }
 
-// A store left by an earlier sweep with the same settings, all its cycles written.
-bool finished(const std::filesystem::path& store,
-              const std::map<std::string, std::string>& parameters, std::int64_t cycles) {
-  if (!std::filesystem::exists(store)) return false;
-  try {
-    const TrajectoryReader run(store);
-    if (run.frame_count() != std::size_t(cycles + 1)) return false;
-    const auto& have = run.header().parameters;
-    for (const auto& [key, value] : parameters) {
-      const auto it = have.find(key);
-      if (it == have.end() || it->second != value) return false;
-    }
-    return true;
-  } catch (const Error&) {
-    return false;  // not a store we can read: run it again
-  }
-}
-
 // The state's sweep: the amplitudes given and, if asked, its training amplitude, ascending.
 std::vector<double> amplitudes_for(const TrainedState& state, const ReadoutSweepOptions& o) {
   std::vector<double> a = o.amplitudes;
@@ -206,7 +187,12 @@ ReadoutSweepSummary run_readout_sweep(
       c.out = readout_run_path(o.dir, o.states[s], a);
       c.parameters = run_parameters(o, o.states[s], a, c.drive);
       c.validate(sim.container().size.y(), sim.physics().dt);
-      const bool reused = finished(c.out, c.parameters, o.cycles);
+      bool reused = false;
+      try {
+        reused = finished_run(c.out, c.parameters, o.cycles);
+      } catch (const Error&) {
+        // not a store we can read: run it again
+      }
       summary.runs.push_back({s, states[s].cycles, states[s].amplitude, a, c.out, reused});
       protocol.push_back(std::move(c));
     }

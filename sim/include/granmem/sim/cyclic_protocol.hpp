@@ -54,6 +54,13 @@ struct CyclicSummary {
 
 std::filesystem::path full_compression_path(const std::filesystem::path& out);
 std::filesystem::path in_cycle_path(const std::filesystem::path& out);
+// True when `out` holds a finished run of these settings: every one of `parameters` in its
+// /parameters with the same value, and end-of-cycle frames up to cycle `cycles`; false
+// when there is no such file. Lets a sweep of runs (a calibration twin, a read-out) that
+// stopped go on without running its finished runs again. Error for a file it cannot read.
+bool finished_run(const std::filesystem::path& out,
+                  const std::map<std::string, std::string>& parameters, std::int64_t cycles);
+
 // <out stem>_state_cycle<cycle>.h5
 std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle);
 

@@ -118,31 +118,69 @@ void Simulation::refresh_forces() {
   compute_forces(false);
 }
 
-GRANMEM_INLINE bool Simulation::pair_contact(std::size_t i, std::uint32_t k, bool commit,
-                                             PairForce& out) {
+GRANMEM_INLINE bool Simulation::touching(std::size_t i, std::uint32_t k, bool commit) {
   const Grains& g = grains_;
   const std::uint32_t j = neighbors_.partner()[k];
   const double reach = g.radius[i] + g.radius[j];
-  if ((g.x[i] - g.x[j]).squaredNorm() >= reach * reach) {
-    active_[k] = 0;
-    if (commit && touching_[k]) {
-      touching_[k] = 0;
-      pair_history_[k] = ContactHistory{};  // the contact broke: forget its springs
+  if ((g.x[i] - g.x[j]).squaredNorm() < reach * reach) return true;
+  active_[k] = 0;
+  if (commit && touching_[k]) {
+    touching_[k] = 0;
+    pair_history_[k] = ContactHistory{};  // the contact broke: forget its springs
+  }
+  return false;
+}
+
+std::uint32_t Simulation::first_outgoing(std::size_t i, Share s) const {
+  const auto& partner = neighbors_.partner();
+  // Partners are sorted by id: those of another share are the last ones.
+  std::uint32_t k = neighbors_.end(i);
+  while (k > neighbors_.begin(i) && rank_[partner[k - 1]] >= s.last)
+    --k;
+  return k;
+}
+
+void Simulation::evaluate_pairs(Share s, std::size_t first, std::size_t last, bool commit,
+                                PairLanes& lanes, std::vector<PairForce>* block) {
+  const bool outgoing = block == nullptr;
+  const Grains& g = grains_;
+  const auto& partner = neighbors_.partner();
+  for (std::size_t r = first; r < last; ++r) {
+    const std::size_t i = by_id_[r];
+    const std::uint32_t split = first_outgoing(i, s);
+    const std::uint32_t begin = outgoing ? split : neighbors_.begin(i);
+    const std::uint32_t end = outgoing ? neighbors_.end(i) : split;
+    for (std::uint32_t k = begin; k < end; ++k) {
+      if (!touching(i, k, commit)) continue;
+      const std::uint32_t j = partner[k];
+      const double sqrt_m = uniform_sqrt_reduced_mass_ > 0
+                                ? uniform_sqrt_reduced_mass_
+                                : sqrt_reduced_mass(g.mass[i], g.mass[j]);
+      lanes.add(k, g.x[i], g.x[j], g.v[i], g.v[j], g.w[i], g.w[j], g.radius[i], g.radius[j], sqrt_m,
+                pair_history_[k]);
+      if (lanes.full()) store_lanes(lanes, commit, block);
     }
-    return false;
   }
-  const double sqrt_m = uniform_sqrt_reduced_mass_ > 0 ? uniform_sqrt_reduced_mass_
-                                                       : sqrt_reduced_mass(g.mass[i], g.mass[j]);
-  const ContactGeometry geometry = sphere_contact(g.x[i], g.x[j], g.radius[i], g.radius[j], g.v[i],
-                                                  g.v[j], g.w[i], g.w[j], sqrt_m);
-  const ContactForces f = grain_contact_.evaluate(geometry, pair_history_[k], physics_.dt);
-  out = {f.force_on_i, f.torque_on_i, f.torque_on_j};
-  active_[k] = 1;
-  if (commit) {
-    pair_history_[k] = f.history;
-    touching_[k] = 1;
+  store_lanes(lanes, commit, block);
+}
+
+void Simulation::store_lanes(PairLanes& lanes, bool commit, std::vector<PairForce>* block) {
+  evaluate_pair_lanes(grain_contact_, lanes, physics_.dt);
+  for (int l = 0; l < lanes.count; ++l) {
+    const std::uint32_t k = lanes.pair[l];
+    PairForce& f = block ? block->emplace_back() : pair_force_[k];
+    for (int a = 0; a < 3; ++a) {
+      f.force_on_i[a] = lanes.force_on_i[a][l];
+      f.torque_on_i[a] = lanes.torque_on_i[a][l];
+      f.torque_on_j[a] = lanes.torque_on_j[a][l];
+    }
+    active_[k] = 1;
+    if (commit) {
+      pair_history_[k] = lanes.history(l);
+      touching_[k] = 1;
+    }
   }
-  return true;
+  lanes.count = 0;
 }
 
 GRANMEM_INLINE void Simulation::add_walls(std::size_t i,
@@ -196,16 +234,8 @@ void Simulation::start_sums(Share s) {
   }
 }
 
-void Simulation::evaluate_outgoing(Share s, bool commit) {
-  const auto& partner = neighbors_.partner();
-  for (std::size_t r = s.first; r < s.last; ++r) {
-    const std::size_t i = by_id_[r];
-    // Partners are sorted by id: those of another share are the last ones.
-    for (std::uint32_t k = neighbors_.end(i); k-- > neighbors_.begin(i);) {
-      if (rank_[partner[k]] < s.last) break;
-      pair_contact(i, k, commit, pair_force_[k]);
-    }
-  }
+void Simulation::evaluate_outgoing(Share s, bool commit, PairLanes& lanes) {
+  evaluate_pairs(s, s.first, s.last, commit, lanes, nullptr);
 }
 
 void Simulation::add_incoming(Share s) {
@@ -225,63 +255,75 @@ void Simulation::add_incoming(Share s) {
   }
 }
 
-void Simulation::finish_sums(Share s, bool commit) {
-  Grains& g = grains_;
-  const auto& partner = neighbors_.partner();
-  const double half_dt = 0.5 * physics_.dt;
+void Simulation::finish_sums(Share s, bool commit, PairLanes& lanes) {
   const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
   std::array<Container::Plane, kWallCount> planes;
   for (int w = 0; w < walls; ++w)
     planes[w] = container_.plane(static_cast<Wall>(w));
-  for (std::size_t r = s.first; r < s.last; ++r) {
-    const std::size_t i = by_id_[r];
-    // Every pair of smaller owner id has been added to grain i: its own come next, in
-    // partner-id order, each reaction added at once to the partner's sum.
-    Eigen::Vector3d f = g.force[i], t = g.torque[i];
-    std::uint32_t k = neighbors_.begin(i);
-    for (; k < neighbors_.end(i); ++k) {
-      const std::uint32_t j = partner[k];
-      if (rank_[j] >= s.last) break;
-      PairForce c;
-      if (!pair_contact(i, k, commit, c)) continue;
-      f += c.force_on_i;
-      t += c.torque_on_i;
+  // In blocks of grains, whose pair forces are kept in order in a buffer that stays in
+  // cache until they are summed.
+  std::vector<PairForce> block;
+  block.reserve(kBlockGrains * 16);
+  for (std::size_t first = s.first; first < s.last; first += kBlockGrains) {
+    const std::size_t last = std::min(first + kBlockGrains, s.last);
+    block.clear();
+    evaluate_pairs(s, first, last, commit, lanes, &block);
+    const PairForce* next = block.data();
+    for (std::size_t r = first; r < last; ++r)
+      sum_grain(s, by_id_[r], next, planes, walls, commit);
+  }
+}
+
+GRANMEM_INLINE void Simulation::sum_grain(Share s, std::size_t i, const PairForce*& next,
+                                          const std::array<Container::Plane, kWallCount>& planes,
+                                          int walls, bool commit) {
+  Grains& g = grains_;
+  const auto& partner = neighbors_.partner();
+  // Every pair of smaller owner id has been added to grain i: its own come next, in
+  // partner-id order, each reaction added at once to a partner of the same share.
+  Eigen::Vector3d f = g.force[i], t = g.torque[i];
+  for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
+    if (!active_[k]) continue;
+    const std::uint32_t j = partner[k];
+    const bool same_share = rank_[j] < s.last;
+    const PairForce& c = same_share ? *next++ : pair_force_[k];
+    f += c.force_on_i;
+    t += c.torque_on_i;
+    if (same_share) {
       g.force[j] -= c.force_on_i;
       g.torque[j] += c.torque_on_j;
     }
-    for (; k < neighbors_.end(i); ++k) {  // evaluated before, for the partner's share
-      if (!active_[k]) continue;
-      f += pair_force_[k].force_on_i;
-      t += pair_force_[k].torque_on_i;
-    }
-    add_walls(i, planes, walls, commit, f, t);
-    g.force[i] = f;
-    g.torque[i] = t;
-    if (commit) {  // the step's second half kick, while the grain is at hand
-      g.v[i] += half_dt * g.inv_mass[i] * f;
-      g.w[i] += half_dt * g.inv_inertia[i] * t;
-    }
+  }
+  add_walls(i, planes, walls, commit, f, t);
+  g.force[i] = f;
+  g.torque[i] = t;
+  if (commit) {  // the step's second half kick, while the grain is at hand
+    const double half_dt = 0.5 * physics_.dt;
+    g.v[i] += half_dt * g.inv_mass[i] * f;
+    g.w[i] += half_dt * g.inv_inertia[i] * t;
   }
 }
 
 // Each grain's forces are summed in the order of its partners' ids: gravity and drag, the
 // pairs it is partner of (owners of smaller id, in id order), then its own pairs (partners
 // of larger id, in id order), then the walls. Grains are walked in id order, each thread
-// over one share of consecutive ids: a pair's reaction is added to its partner as soon as
-// it is evaluated, except across shares, where it is stored, and added first once every
-// thread is done with such pairs (their owners' ids are smaller than any in the share).
+// over one share of consecutive ids, in blocks: the block's pairs are evaluated in lanes
+// (pair_lanes.hpp), then each grain's sum is made and its reactions added to its partners;
+// across shares, the pairs are evaluated first and their reactions added before the
+// share's own (their owners' ids are smaller than any in the share).
 void Simulation::compute_forces(bool commit) {
 #pragma omp parallel num_threads(threads_)
   {
     const int threads = omp_get_num_threads();
     const Share s = share(omp_get_thread_num(), threads);
+    PairLanes lanes;
     start_sums(s);
     if (threads > 1) {
-      evaluate_outgoing(s, commit);
+      evaluate_outgoing(s, commit, lanes);
 #pragma omp barrier
       add_incoming(s);
     }
-    finish_sums(s, commit);
+    finish_sums(s, commit, lanes);
   }
   sum_wall_loads();
 }

@@ -41,6 +41,19 @@ class ContactModel {
 
   GRANMEM_INLINE ContactForces evaluate(const ContactGeometry& g, const ContactHistory& before,
                                         double dt) const {
+    if (rolling_.enabled) {
+      return twisting_.enabled ? evaluate_modes<true, true>(g, before, dt)
+                               : evaluate_modes<true, false>(g, before, dt);
+    }
+    return twisting_.enabled ? evaluate_modes<false, true>(g, before, dt)
+                             : evaluate_modes<false, false>(g, before, dt);
+  }
+
+  // The law with its rolling and twisting modes on or off at compile time: a loop over
+  // contacts then has no branch (evaluate() above picks the modes the parameters enable).
+  template <bool kRolling, bool kTwisting>
+  GRANMEM_INLINE ContactForces evaluate_modes(const ContactGeometry& g,
+                                              const ContactHistory& before, double dt) const {
     ContactForces out;
     const double fn = normal_.magnitude(g);
     out.normal_force = fn;
@@ -51,13 +64,13 @@ class ContactModel {
     // from i's centre and +l n from j's; rolling and twisting act through l_ij.
     Eigen::Vector3d lever_i = -g.l_i * slide.force, lever_j = -g.l_j * slide.force;
     double twist_moment = 0;
-    if (rolling_.enabled) {
+    if constexpr (kRolling) {
       const SpringSlider roll = rolling_.evaluate(g, fn, before.roll, dt);
       out.history.roll = roll.spring;
       lever_i += g.l_ij * roll.force;
       lever_j -= g.l_ij * roll.force;
     }
-    if (twisting_.enabled) {
+    if constexpr (kTwisting) {
       const TwistingFriction::Result twist = twisting_.evaluate(g, fn, before.twist, dt);
       out.history.twist = twist.spring;
       twist_moment = g.l_ij * twist.force;
@@ -67,6 +80,8 @@ class ContactModel {
     return out;
   }
 
+  bool rolling() const { return rolling_.enabled; }
+  bool twisting() const { return twisting_.enabled; }
   const NormalForce& normal() const { return normal_; }
 
  private:

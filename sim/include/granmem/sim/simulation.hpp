@@ -12,6 +12,7 @@
 #include "granmem/sim/container.hpp"
 #include "granmem/sim/grains.hpp"
 #include "granmem/sim/neighbor_list.hpp"
+#include "granmem/sim/pair_lanes.hpp"
 
 namespace granmem {
 
@@ -121,12 +122,26 @@ class Simulation {
   Share share(int thread, int threads) const;
   // The stages of compute_forces, over one share.
   void start_sums(Share s);
-  void evaluate_outgoing(Share s, bool commit);
+  void evaluate_outgoing(Share s, bool commit, PairLanes& lanes);
   void add_incoming(Share s);
-  void finish_sums(Share s, bool commit);
+  void finish_sums(Share s, bool commit, PairLanes& lanes);
   void sum_wall_loads();
-  // Pair k, owned by grain i: false if its grains do not touch, else its forces in `out`.
-  bool pair_contact(std::size_t i, std::uint32_t k, bool commit, PairForce& out);
+  // Pair k, owned by grain i: whether its grains overlap. One that does not forgets its
+  // springs (with `commit`).
+  bool touching(std::size_t i, std::uint32_t k, bool commit);
+  // Grain i's first pair whose partner is beyond share s (its pairs are sorted by id).
+  std::uint32_t first_outgoing(std::size_t i, Share s) const;
+  // The touching pairs owned by the grains at id ranks [first, last) of share s, evaluated
+  // through `lanes`: those with their partner in the share, forces appended to `block` in
+  // the order of the grains and their pairs; or, with no block, those whose partner is
+  // beyond the share, forces into pair_force_.
+  void evaluate_pairs(Share s, std::size_t first, std::size_t last, bool commit, PairLanes& lanes,
+                      std::vector<PairForce>* block);
+  void store_lanes(PairLanes& lanes, bool commit, std::vector<PairForce>* block);
+  // Grain i's sum of its own pairs (those in the share next in `block_forces`) and walls,
+  // its reactions added to partners in share s; with `commit`, its second half kick.
+  void sum_grain(Share s, std::size_t i, const PairForce*& block_forces,
+                 const std::array<Container::Plane, kWallCount>& planes, int walls, bool commit);
   void add_walls(std::size_t i, const std::array<Container::Plane, kWallCount>& planes, int walls,
                  bool commit, Eigen::Vector3d& f, Eigen::Vector3d& t);
 
@@ -149,6 +164,7 @@ class Simulation {
   std::vector<std::uint32_t> rank_;  // each grain's position in by_id_
   std::vector<double> sqrt_mass_;    // for the wall contacts' dashpots
   static constexpr std::size_t kGrainsPerThread = 2500;
+  static constexpr std::size_t kBlockGrains = 32;  // grains whose pairs are evaluated together
   int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass
   double time_ = 0;

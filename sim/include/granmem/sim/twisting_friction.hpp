@@ -43,10 +43,9 @@ struct TwistingFriction {
     Result r;
     r.spring = spring + v * dt;
     r.force = -k * r.spring - c * v;
-    if (std::abs(r.force) > cap) {
-      r.force = std::copysign(cap, r.force);
-      r.spring = -inv_k * (r.force + c * v);
-    }
+    const bool slips = std::abs(r.force) > cap;
+    r.force = slips ? std::copysign(cap, r.force) : r.force;
+    r.spring = slips ? -inv_k * (r.force + c * v) : r.spring;
     return r;
   }
 };

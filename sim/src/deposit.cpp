@@ -42,9 +42,6 @@ double packing_fraction(const Simulation& sim) {
   return box > 0 ? volume / box : 0;
 }
 
-namespace {
-
-// Runs with the settling drag until the kinetic energy per grain is below the threshold.
 double settle(Simulation& sim, const DepositOptions& o, const std::string& stage,
               const DepositProgress& progress) {
   const double n = double(std::max<std::size_t>(sim.grains().size(), 1));
@@ -66,8 +63,6 @@ double settle(Simulation& sim, const DepositOptions& o, const std::string& stage
   sim.set_background_damping(0);
   return sim.time() - start;
 }
-
-}  // namespace
 
 Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
   if (o.grains < 1) throw Error("deposit: needs at least one grain");

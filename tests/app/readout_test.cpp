@@ -67,6 +67,17 @@ TEST_F(Readout, AtTheTrainingAmplitudeItIsTheRunsNextCycleAndFinishedRunsAreReus
   EXPECT_EQ(read_file(in_work("ro") / "readout.csv"), table);
 }
 
+// The options from a [readout] section of a TOML file, as on the command line.
+TEST_F(Readout, ATomlSectionGivesItsOptions) {
+  write_text(in_work("readout.toml"),
+             "[readout]\nfrom = [\"train_state_cycle1.h5\"]\namplitudes = \"0.5%,3%\"\n"
+             "inertial-number = 1e-2\nout = \"ro\"\n");
+  const RunResult r = granmem_ok({"--config", "readout.toml", "readout"});
+  EXPECT_NE(r.err.find("3/3 runs done"), std::string::npos) << r.err;
+  const Table t = read_columns(in_work("ro") / "readout.csv", {"amplitude_pct"});
+  EXPECT_EQ(t["amplitude_pct"].values, (std::vector<double>{0.5, 2, 3}));
+}
+
 #ifdef GRANMEM_MPIEXEC
 // On 2 MPI ranks (a -DGRANMEM_MPI=ON build): the runs are shared out, and every store and
 // the table are those of the single-process read-out, bit for bit.

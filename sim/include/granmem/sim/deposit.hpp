@@ -44,6 +44,12 @@ DepositProgress print_deposit_progress(std::ostream& out);
 Simulation deposit(const DepositOptions& options, const PhysicsOptions& physics,
                    DepositSummary* summary = nullptr, const DepositProgress& progress = {});
 
+// Runs `sim` under the settling drag of `options` until the kinetic energy per grain is
+// below options.settled_energy (deposit()'s stages); returns the simulated time it took.
+// Throws Error if that takes longer than options.max_settling_time.
+double settle(Simulation& sim, const DepositOptions& options, const std::string& stage,
+              const DepositProgress& progress = {});
+
 // The grains as deposit() inserts them, before anything moves: positions on the jittered
 // lattice, radii, random velocities and orientations drawn from `options.seed`. deposit()
 // starts from exactly these, so other codes can be started from the same state.

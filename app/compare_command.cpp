@@ -12,6 +12,7 @@ void add_compare(CLI::App& app) {
   struct Args {
     std::string a, b, out, window, diameter, label_a = "A", label_b = "B", wall_distance = "0";
     bool keep_drift = false;
+    std::size_t steady_points = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -40,6 +41,10 @@ void add_compare(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--keep-drift", args->keep_drift,
                 "keep the packing's mean displacement (default: subtracted)");
+  cmd->add_option("--steady-points", args->steady_points,
+                  "relaxation (Fig. 3): hold the steady state at the mean of the last N cycles, "
+                  "the paper's way (20 of its 500), instead of fitting it (0)")
+      ->capture_default_str();
   cmd->callback([args] {
     const TrajectoryReader a(args->a), b(args->b);
     ObservableOptions o;
@@ -56,8 +61,10 @@ void add_compare(CLI::App& app) {
     } else {
       o.window = parse_int_range(args->window, "--window");
     }
+    PowerLawOptions relaxation;
+    relaxation.steady_points = args->steady_points;
     const Comparison c = compare_runs(a, b, args->label_a, args->label_b, o,
-                                      Eigen::Vector3d::Ones(), 0.0, args->out);
+                                      Eigen::Vector3d::Ones(), 0.0, args->out, relaxation);
     std::cout << "wrote " << c.written.size() << " files in " << args->out << "\n";
   });
 }

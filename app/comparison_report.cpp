@@ -33,7 +33,8 @@ DisplacementField field_of(const TrajectoryReader& run, const ObservableOptions&
 
 // The relaxation's power law, or nothing (with a note) when the run is too short for it.
 bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cycle,
-                   const std::vector<double>& mean, std::vector<Relaxation>* out) {
+                   const std::vector<double>& mean, const PowerLawOptions& options,
+                   std::vector<Relaxation>* out) {
   Relaxation r;
   r.label = label;
   for (std::size_t k = 0; k < cycle.size(); ++k) {
@@ -41,7 +42,7 @@ bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cy
     r.mean.push_back(mean[k]);
   }
   try {
-    r.fit = fit_power_law(r.cycle, r.mean, {});
+    r.fit = fit_power_law(r.cycle, r.mean, {}, options);
   } catch (const Error& e) {
     std::cerr << "granmem: note: no power law for " << label << ": " << e.what() << "\n";
     return false;
@@ -55,7 +56,7 @@ bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cy
 Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                         const std::string& label_a, const std::string& label_b,
                         const ObservableOptions& observe, const Eigen::Vector3d& noise_shape,
-                        double sigma, const fs::path& dir) {
+                        double sigma, const fs::path& dir, const PowerLawOptions& relaxation) {
   ObservableOptions oa = observe, ob = observe;
   oa.rotations = a.header().has_axis || a.header().has_orientation;
   ob.rotations = b.header().has_axis || b.header().has_orientation;
@@ -127,15 +128,15 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
 
   // Fig. 3: relaxation towards the steady state.
   std::vector<Relaxation> trans, rot;
-  relaxation_of(label_a, x.cycle, x.mean_dr, &trans);
-  relaxation_of(label_b, y.cycle, y.mean_dr, &trans);
+  relaxation_of(label_a, x.cycle, x.mean_dr, relaxation, &trans);
+  relaxation_of(label_b, y.cycle, y.mean_dr, relaxation, &trans);
   if (!trans.empty()) {
     add(plot_relaxation(dir, "relaxation_translation", trans,
                         "mean displacement per cycle - steady state [d]",
                         "Translations: relaxation to the steady state"));
   }
-  if (oa.rotations) relaxation_of(label_a, x.cycle, x.mean_rot_disp, &rot);
-  if (ob.rotations) relaxation_of(label_b, y.cycle, y.mean_rot_disp, &rot);
+  if (oa.rotations) relaxation_of(label_a, x.cycle, x.mean_rot_disp, relaxation, &rot);
+  if (ob.rotations) relaxation_of(label_b, y.cycle, y.mean_rot_disp, relaxation, &rot);
   if (!rot.empty()) {
     add(plot_relaxation(dir, "relaxation_rotation", rot,
                         "mean rotational displacement per cycle - steady state [d]",

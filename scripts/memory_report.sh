@@ -18,7 +18,9 @@
 #   <name>_training.csv  the trainings themselves (DIR/mu<M>_seed<S>.h5, `granmem compare`
 #                        of seed 1 and seed 2 of each mu_s, drift removed): mean end-of-cycle
 #                        displacement and single-axis rotation over the last --last cycles,
-#                        KS distance between the seeds, relaxation exponents (Figs 2a, 3)
+#                        KS distance between the seeds, relaxation exponents (Figs 2a, 3),
+#                        the steady state fitted (relax_exp_*) and held at the mean of the
+#                        last --last cycles as the paper does (held_exp_*)
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -133,7 +135,7 @@ GP
 plot 'set terminal pngcairo size 1500,900 font ",10"' "$out/$name.png"
 plot 'set terminal svg size 1500,900 font "Arial,10"' "$out/$name.svg"
 # The trainings: seed 1 against seed 2 of each friction over the last cycles.
-echo "mu_s,cycles,window,mean_dr_seed1_d,mean_dr_seed2_d,ks_dr,mean_rot_seed1_d,mean_rot_seed2_d,ks_rot,relax_exp_dr_seed1,relax_exp_dr_seed2,relax_exp_rot_seed1,relax_exp_rot_seed2" > "$out/${name}_training.csv"
+echo "mu_s,cycles,window,mean_dr_seed1_d,mean_dr_seed2_d,ks_dr,mean_rot_seed1_d,mean_rot_seed2_d,ks_rot,relax_exp_dr_seed1,relax_exp_dr_seed2,relax_exp_rot_seed1,relax_exp_rot_seed2,held_exp_dr_seed1,held_exp_dr_seed2,held_exp_rot_seed1,held_exp_rot_seed2" > "$out/${name}_training.csv"
 for m in $mus; do
   a="$runs/mu${m}_seed1.h5" b="$runs/mu${m}_seed2.h5"
   [[ -s $a && -s $b ]] || continue
@@ -142,12 +144,17 @@ for m in $mus; do
   said=$("$granmem" compare "$a" "$b" --window "$window" --out "$runs/compare_mu$m" \
     --label-a "mu_s $m seed 1" --label-b "mu_s $m seed 2" 2>&1)
   exps=$(echo "$said" | awk '/relaxation of/ { printf ",%s", $(NF - 2) }')
-  awk -F, -v m="$m" -v c="$cycles" -v w="$window" -v e="$exps" '
+  # The paper's way: the steady state held at the mean of the last cycles, not fitted.
+  held=$("$granmem" compare "$a" "$b" --window "$window" --steady-points "$last" \
+    --out "$runs/compare_mu${m}_held" --label-a "mu_s $m seed 1" --label-b "mu_s $m seed 2" 2>&1 |
+    awk '/relaxation of/ { printf ",%s", $(NF - 2) }')
+  awk -F, -v m="$m" -v c="$cycles" -v w="$window" -v e="$exps" -v h="$held" '
     /^#/ || /^quantity/ { next }
     { mean1[$1] = $4; mean2[$1] = $5; ks[$1] = $8 }
-    END { n = split(substr(e, 2), x, ",")
+    END { n = split(substr(e, 2), x, ","); nh = split(substr(h, 2), y, ",")
           printf "%s,%s,%s,%s,%s,%s,%s,%s,%s", m, c, w, mean1[1], mean2[1], ks[1], mean1[2], mean2[2], ks[2]
-          for (k = 1; k <= 4; k++) printf ",%s", (k <= n ? x[k] : "nan"); print "" }' \
+          for (k = 1; k <= 4; k++) printf ",%s", (k <= n ? x[k] : "nan")
+          for (k = 1; k <= 4; k++) printf ",%s", (k <= nh ? y[k] : "nan"); print "" }' \
     "$runs/compare_mu$m/distances.csv" >> "$out/${name}_training.csv"
 done
 

@@ -26,7 +26,8 @@ struct PairLanes {
   double force_on_i[3][kCapacity], torque_on_i[3][kCapacity], torque_on_j[3][kCapacity];
 
   bool full() const { return count == kCapacity; }
-  // Appends pair `index` between grains at x_i and x_j; false once full.
+  // Appends pair `index` between grains at x_i and x_j; the caller empties a full batch
+  // (evaluate_pair_lanes, then count = 0) before adding more.
   void add(std::uint32_t index, const Eigen::Vector3d& xi, const Eigen::Vector3d& xj,
            const Eigen::Vector3d& vi, const Eigen::Vector3d& vj, const Eigen::Vector3d& wi,
            const Eigen::Vector3d& wj, double ri, double rj, double sqrt_m,
@@ -57,10 +58,11 @@ struct PairLanes {
   }
 };
 
-// The contact law (ContactModel::evaluate on sphere_contact) for every lane. A pair's result
-// does not depend on its place in the batch. Built for the widest vectors the processor has
-// (AVX-512, AVX2 or the x86-64 baseline, chosen when the program loads), without fused
-// multiply-adds, so that each width does the same arithmetic.
+// The contact law (ContactModel::evaluate on sphere_contact) for every lane, to rounding (the
+// one-pair law elsewhere may use Eigen's SSE code or fused multiply-adds). A pair's result
+// does not depend on its place in the batch. With GCC on x86-64 Linux it is built for
+// AVX-512, AVX2 and the baseline, the widest the processor has chosen when the program
+// loads, without fused multiply-adds, so that each width does the same arithmetic.
 void evaluate_pair_lanes(const ContactModel& model, PairLanes& lanes, double dt);
 
 }  // namespace granmem

@@ -111,6 +111,7 @@ set multiplot layout 2,$columns title "$title (first read-out cycle; mean of the
 set logscale xy
 set xrange [0.03:4]
 set format x "%g"
+set format y "%g"
 set key top left font ",9"
 set grid
 mus = "$mus"

@@ -14,22 +14,27 @@ namespace {
 
 // Orientation q turned by the rotation vector `turn` (a sphere's w is constant over a
 // step, so this is exact). For the small turns of a step, sin and cos of the half angle
-// come from their series, exact to double precision below 1e-2 rad.
+// come from their series, exact to double precision below 1e-2 rad; by multiplications
+// (a division costs as much as the rest of the step's integration).
 Eigen::Quaterniond turned(const Eigen::Quaterniond& q, const Eigen::Vector3d& turn) {
   const double angle_sq = turn.squaredNorm();
   if (angle_sq == 0) return q;
   double c, s_over_angle;  // cos(angle/2), sin(angle/2)/angle
   if (angle_sq < 1e-4) {
     const double h2 = 0.25 * angle_sq;  // (angle/2)^2
-    c = 1 - h2 / 2 * (1 - h2 / 12 * (1 - h2 / 30 * (1 - h2 / 56)));
-    s_over_angle = 0.5 * (1 - h2 / 6 * (1 - h2 / 20 * (1 - h2 / 42 * (1 - h2 / 72))));
+    constexpr double k2 = 1.0 / 2, k12 = 1.0 / 12, k30 = 1.0 / 30, k56 = 1.0 / 56;
+    constexpr double k6 = 1.0 / 6, k20 = 1.0 / 20, k42 = 1.0 / 42, k72 = 1.0 / 72;
+    c = 1 - h2 * k2 * (1 - h2 * k12 * (1 - h2 * k30 * (1 - h2 * k56)));
+    s_over_angle = 0.5 * (1 - h2 * k6 * (1 - h2 * k20 * (1 - h2 * k42 * (1 - h2 * k72))));
   } else {
     const double angle = std::sqrt(angle_sq);
     c = std::cos(0.5 * angle);
     s_over_angle = std::sin(0.5 * angle) / angle;
   }
   const Eigen::Vector3d v = s_over_angle * turn;
-  return (Eigen::Quaterniond(c, v.x(), v.y(), v.z()) * q).normalized();
+  Eigen::Quaterniond out = Eigen::Quaterniond(c, v.x(), v.y(), v.z()) * q;
+  out.coeffs() *= 1 / out.coeffs().norm();
+  return out;
 }
 
 }  // namespace
@@ -140,58 +145,59 @@ std::uint32_t Simulation::first_outgoing(std::size_t i, Share s) const {
   return k;
 }
 
-void Simulation::evaluate_pairs(Share s, std::size_t first, std::size_t last, bool commit,
-                                PairLanes& lanes, std::vector<PairForce>* block) {
-  const bool outgoing = block == nullptr;
+GRANMEM_INLINE void Simulation::add_pair(PairLanes& lanes, std::uint32_t k, std::size_t i,
+                                         std::uint32_t j) const {
   const Grains& g = grains_;
-  const auto& partner = neighbors_.partner();
-  for (std::size_t r = first; r < last; ++r) {
-    const std::size_t i = by_id_[r];
-    const std::uint32_t split = first_outgoing(i, s);
-    const std::uint32_t begin = outgoing ? split : neighbors_.begin(i);
-    const std::uint32_t end = outgoing ? neighbors_.end(i) : split;
-    for (std::uint32_t k = begin; k < end; ++k) {
-      if (!touching(i, k, commit)) continue;
-      const std::uint32_t j = partner[k];
-      const double sqrt_m = uniform_sqrt_reduced_mass_ > 0
-                                ? uniform_sqrt_reduced_mass_
-                                : sqrt_reduced_mass(g.mass[i], g.mass[j]);
-      lanes.add(k, g.x[i], g.x[j], g.v[i], g.v[j], g.w[i], g.w[j], g.radius[i], g.radius[j], sqrt_m,
-                pair_history_[k]);
-      if (lanes.full()) store_lanes(lanes, commit, block);
-    }
-  }
-  store_lanes(lanes, commit, block);
+  const double sqrt_m = uniform_sqrt_reduced_mass_ > 0 ? uniform_sqrt_reduced_mass_
+                                                       : sqrt_reduced_mass(g.mass[i], g.mass[j]);
+  lanes.add(k, g.x[i], g.x[j], g.v[i], g.v[j], g.w[i], g.w[j], g.radius[i], g.radius[j], sqrt_m,
+            pair_history_[k]);
 }
 
-void Simulation::store_lanes(PairLanes& lanes, bool commit, std::vector<PairForce>* block) {
+void Simulation::evaluate_outgoing(Share s, bool commit, PairLanes& lanes) {
+  const auto& partner = neighbors_.partner();
+  auto store = [&] {
+    evaluate_lanes(lanes, commit);
+    for (int l = 0; l < lanes.count; ++l) {
+      PairForce& f = pair_force_[lanes.pair[l]];
+      for (int a = 0; a < 3; ++a) {
+        f.force_on_i[a] = lanes.force_on_i[a][l];
+        f.torque_on_i[a] = lanes.torque_on_i[a][l];
+        f.torque_on_j[a] = lanes.torque_on_j[a][l];
+      }
+    }
+    lanes.count = 0;
+  };
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t i = by_id_[r];
+    for (std::uint32_t k = first_outgoing(i, s); k < neighbors_.end(i); ++k) {
+      if (!touching(i, k, commit)) continue;
+      add_pair(lanes, k, i, partner[k]);
+      if (lanes.full()) store();
+    }
+  }
+  store();
+}
+
+void Simulation::evaluate_lanes(PairLanes& lanes, bool commit) {
   evaluate_pair_lanes(grain_contact_, lanes, physics_.dt);
   for (int l = 0; l < lanes.count; ++l) {
     const std::uint32_t k = lanes.pair[l];
-    PairForce& f = block ? block->emplace_back() : pair_force_[k];
-    for (int a = 0; a < 3; ++a) {
-      f.force_on_i[a] = lanes.force_on_i[a][l];
-      f.torque_on_i[a] = lanes.torque_on_i[a][l];
-      f.torque_on_j[a] = lanes.torque_on_j[a][l];
-    }
     active_[k] = 1;
     if (commit) {
       pair_history_[k] = lanes.history(l);
       touching_[k] = 1;
     }
   }
-  lanes.count = 0;
 }
 
-GRANMEM_INLINE void Simulation::add_walls(std::size_t i,
-                                          const std::array<Container::Plane, kWallCount>& planes,
-                                          int walls, bool commit, Eigen::Vector3d& f,
-                                          Eigen::Vector3d& t) {
+GRANMEM_INLINE void Simulation::add_walls(std::size_t i, const Planes& planes, bool commit,
+                                          Eigen::Vector3d& f, Eigen::Vector3d& t) {
   const Grains& g = grains_;
   std::uint8_t touch = 0;
   const std::uint8_t remembered = wall_remembered_[i];
-  for (int w = 0; w < walls; ++w) {
-    const Container::Plane& p = planes[w];
+  for (int w = 0; w < planes.count; ++w) {
+    const Container::Plane& p = planes.plane[w];
     const double distance = p.normal.dot(g.x[i]) - p.offset;
     ContactHistory& history = wall_history_[i][w];
     if (distance >= g.radius[i]) {
@@ -234,10 +240,6 @@ void Simulation::start_sums(Share s) {
   }
 }
 
-void Simulation::evaluate_outgoing(Share s, bool commit, PairLanes& lanes) {
-  evaluate_pairs(s, s.first, s.last, commit, lanes, nullptr);
-}
-
 void Simulation::add_incoming(Share s) {
   const auto& incoming = neighbors_.incoming();
   const auto& owner = neighbors_.owner();
@@ -256,47 +258,71 @@ void Simulation::add_incoming(Share s) {
 }
 
 void Simulation::finish_sums(Share s, bool commit, PairLanes& lanes) {
-  const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
-  std::array<Container::Plane, kWallCount> planes;
-  for (int w = 0; w < walls; ++w)
-    planes[w] = container_.plane(static_cast<Wall>(w));
-  // In blocks of grains, whose pair forces are kept in order in a buffer that stays in
-  // cache until they are summed.
-  std::vector<PairForce> block;
-  block.reserve(kBlockGrains * 16);
-  for (std::size_t first = s.first; first < s.last; first += kBlockGrains) {
-    const std::size_t last = std::min(first + kBlockGrains, s.last);
-    block.clear();
-    evaluate_pairs(s, first, last, commit, lanes, &block);
-    const PairForce* next = block.data();
-    for (std::size_t r = first; r < last; ++r)
-      sum_grain(s, by_id_[r], next, planes, walls, commit);
+  Planes planes;
+  planes.count = container_.lid.present ? kWallCount : kWallCount - 1;
+  for (int w = 0; w < planes.count; ++w)
+    planes.plane[w] = container_.plane(static_cast<Wall>(w));
+  const auto& partner = neighbors_.partner();
+  std::vector<PendingGrain> pending;
+  pending.reserve(kPendingGrains + 1);
+  for (std::size_t r = s.first; r < s.last; ++r) {
+    const std::size_t i = by_id_[r];
+    const std::uint32_t outgoing = first_outgoing(i, s);
+    pending.push_back({std::uint32_t(r), outgoing, lanes.count, lanes.count, false});
+    for (std::uint32_t k = neighbors_.begin(i); k < outgoing; ++k) {
+      if (!touching(i, k, commit)) continue;
+      add_pair(lanes, k, i, partner[k]);
+      if (lanes.full()) {
+        pending.back().last_lane = lanes.count;
+        sum_pending(commit, lanes, pending, planes);
+        pending.push_back({std::uint32_t(r), outgoing, 0, 0, false});
+      }
+    }
+    pending.back().last_lane = lanes.count;
+    pending.back().complete = true;
+    if (pending.size() >= kPendingGrains) sum_pending(commit, lanes, pending, planes);
   }
+  sum_pending(commit, lanes, pending, planes);
 }
 
-GRANMEM_INLINE void Simulation::sum_grain(Share s, std::size_t i, const PairForce*& next,
-                                          const std::array<Container::Plane, kWallCount>& planes,
-                                          int walls, bool commit) {
+void Simulation::sum_pending(bool commit, PairLanes& lanes, std::vector<PendingGrain>& pending,
+                             const Planes& planes) {
+  evaluate_lanes(lanes, commit);
   Grains& g = grains_;
   const auto& partner = neighbors_.partner();
-  // Every pair of smaller owner id has been added to grain i: its own come next, in
-  // partner-id order, each reaction added at once to a partner of the same share.
-  Eigen::Vector3d f = g.force[i], t = g.torque[i];
-  for (std::uint32_t k = neighbors_.begin(i); k < neighbors_.end(i); ++k) {
-    if (!active_[k]) continue;
-    const std::uint32_t j = partner[k];
-    const bool same_share = rank_[j] < s.last;
-    const PairForce& c = same_share ? *next++ : pair_force_[k];
-    f += c.force_on_i;
-    t += c.torque_on_i;
-    if (same_share) {
-      g.force[j] -= c.force_on_i;
-      g.torque[j] += c.torque_on_j;
+  for (const PendingGrain& p : pending) {
+    const std::size_t i = by_id_[p.rank];
+    // Every pair of smaller owner id has been added to grain i: its own come next, in
+    // partner-id order, each reaction added at once to its partner.
+    Eigen::Vector3d f = g.force[i], t = g.torque[i];
+    for (int l = p.first_lane; l < p.last_lane; ++l) {
+      const std::uint32_t j = partner[lanes.pair[l]];
+      for (int a = 0; a < 3; ++a) {
+        f[a] += lanes.force_on_i[a][l];
+        t[a] += lanes.torque_on_i[a][l];
+        g.force[j][a] -= lanes.force_on_i[a][l];
+        g.torque[j][a] += lanes.torque_on_j[a][l];
+      }
     }
+    if (p.complete) finish_grain(i, p, planes, commit, f, t);
+    g.force[i] = f;
+    g.torque[i] = t;
   }
-  add_walls(i, planes, walls, commit, f, t);
-  g.force[i] = f;
-  g.torque[i] = t;
+  lanes.count = 0;
+  pending.clear();
+}
+
+GRANMEM_INLINE void Simulation::finish_grain(std::size_t i, const PendingGrain& p,
+                                             const Planes& planes, bool commit, Eigen::Vector3d& f,
+                                             Eigen::Vector3d& t) {
+  Grains& g = grains_;
+  // The pairs whose partner is in a later share (partners of larger id than any in it).
+  for (std::uint32_t k = p.outgoing; k < neighbors_.end(i); ++k) {
+    if (!active_[k]) continue;
+    f += pair_force_[k].force_on_i;
+    t += pair_force_[k].torque_on_i;
+  }
+  add_walls(i, planes, commit, f, t);
   if (commit) {  // the step's second half kick, while the grain is at hand
     const double half_dt = 0.5 * physics_.dt;
     g.v[i] += half_dt * g.inv_mass[i] * f;
@@ -307,8 +333,9 @@ GRANMEM_INLINE void Simulation::sum_grain(Share s, std::size_t i, const PairForc
 // Each grain's forces are summed in the order of its partners' ids: gravity and drag, the
 // pairs it is partner of (owners of smaller id, in id order), then its own pairs (partners
 // of larger id, in id order), then the walls. Grains are walked in id order, each thread
-// over one share of consecutive ids, in blocks: the block's pairs are evaluated in lanes
-// (pair_lanes.hpp), then each grain's sum is made and its reactions added to its partners;
+// over one share of consecutive ids: their touching pairs fill a batch of lanes
+// (pair_lanes.hpp); when it is full the law runs on it and the waiting grains' sums are
+// made from it, each reaction added at once to its partner (no pair force is stored);
 // across shares, the pairs are evaluated first and their reactions added before the
 // share's own (their owners' ids are smaller than any in the share).
 void Simulation::compute_forces(bool commit) {

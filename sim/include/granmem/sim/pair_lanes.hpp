@@ -11,7 +11,7 @@ namespace granmem {
 // springs before the step with add(), evaluate_pair_lanes() replaces the springs with
 // their state after the step and writes the forces.
 struct PairLanes {
-  static constexpr int kCapacity = 32;
+  static constexpr int kCapacity = 64;
   int count = 0;
   std::uint32_t pair[kCapacity];  // the caller's index of each pair
   // Grain i (the owner) and grain j: centres, velocities, angular velocities, radii.

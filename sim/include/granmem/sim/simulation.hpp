@@ -122,7 +122,6 @@ class Simulation {
   Share share(int thread, int threads) const;
   // The stages of compute_forces, over one share.
   void start_sums(Share s);
-  void evaluate_outgoing(Share s, bool commit, PairLanes& lanes);
   void add_incoming(Share s);
   void finish_sums(Share s, bool commit, PairLanes& lanes);
   void sum_wall_loads();
@@ -131,19 +130,34 @@ class Simulation {
   bool touching(std::size_t i, std::uint32_t k, bool commit);
   // Grain i's first pair whose partner is beyond share s (its pairs are sorted by id).
   std::uint32_t first_outgoing(std::size_t i, Share s) const;
-  // The touching pairs owned by the grains at id ranks [first, last) of share s, evaluated
-  // through `lanes`: those with their partner in the share, forces appended to `block` in
-  // the order of the grains and their pairs; or, with no block, those whose partner is
-  // beyond the share, forces into pair_force_.
-  void evaluate_pairs(Share s, std::size_t first, std::size_t last, bool commit, PairLanes& lanes,
-                      std::vector<PairForce>* block);
-  void store_lanes(PairLanes& lanes, bool commit, std::vector<PairForce>* block);
-  // Grain i's sum of its own pairs (those in the share next in `block_forces`) and walls,
-  // its reactions added to partners in share s; with `commit`, its second half kick.
-  void sum_grain(Share s, std::size_t i, const PairForce*& block_forces,
-                 const std::array<Container::Plane, kWallCount>& planes, int walls, bool commit);
-  void add_walls(std::size_t i, const std::array<Container::Plane, kWallCount>& planes, int walls,
-                 bool commit, Eigen::Vector3d& f, Eigen::Vector3d& t);
+  // Pair k between grains i and j into the next lane.
+  void add_pair(PairLanes& lanes, std::uint32_t k, std::size_t i, std::uint32_t j) const;
+  // The touching pairs whose partner is beyond share s, evaluated into pair_force_.
+  void evaluate_outgoing(Share s, bool commit, PairLanes& lanes);
+  // The law on a batch of lanes; the springs and contact flags of its pairs stored.
+  void evaluate_lanes(PairLanes& lanes, bool commit);
+
+  // A grain of the share whose sum waits for a batch of lanes: its pairs in the share are
+  // lanes [first_lane, last_lane); `complete` once they all are (a grain with more touching
+  // pairs than a batch holds is summed over several).
+  struct PendingGrain {
+    std::uint32_t rank, outgoing;  // position in id order; first pair beyond the share
+    int first_lane, last_lane;
+    bool complete;
+  };
+  struct Planes {
+    std::array<Container::Plane, kWallCount> plane;
+    int count;
+  };
+  // Evaluates the batch and makes the pending grains' sums in id order: a grain's pairs in
+  // the share, each reaction added at once to its partner, then (complete grains) its
+  // pairs beyond the share, its walls and, with `commit`, its second half kick.
+  void sum_pending(bool commit, PairLanes& lanes, std::vector<PendingGrain>& pending,
+                   const Planes& planes);
+  void finish_grain(std::size_t i, const PendingGrain& p, const Planes& planes, bool commit,
+                    Eigen::Vector3d& f, Eigen::Vector3d& t);
+  void add_walls(std::size_t i, const Planes& planes, bool commit, Eigen::Vector3d& f,
+                 Eigen::Vector3d& t);
 
   Grains grains_;
   Container container_;
@@ -164,7 +178,7 @@ class Simulation {
   std::vector<std::uint32_t> rank_;  // each grain's position in by_id_
   std::vector<double> sqrt_mass_;    // for the wall contacts' dashpots
   static constexpr std::size_t kGrainsPerThread = 2500;
-  static constexpr std::size_t kBlockGrains = 32;  // grains whose pairs are evaluated together
+  static constexpr std::size_t kPendingGrains = 128;  // most grains waiting for one batch
   int threads_ = 1;
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass
   double time_ = 0;

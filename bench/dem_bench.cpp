@@ -35,6 +35,7 @@
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/quasi_static.hpp"
 #include "granmem/sim/simulation.hpp"
+#include "granmem/sim/spatial_order.hpp"
 #include "granmem/sim/wall_drive.hpp"
 
 namespace {
@@ -207,7 +208,8 @@ int tile(const std::vector<std::string>& a) {
       }
     }
   }
-  Simulation sim(std::move(all), box, one.physics());
+  // In spatial order: the copies' ids would otherwise put neighbours across a seam far apart.
+  Simulation sim = granmem::in_spatial_order(Simulation(std::move(all), box, one.physics()));
   const auto start = Clock::now();
   const double settling = granmem::settle(sim, granmem::DepositOptions{}, "tiled",
                                           granmem::print_deposit_progress(std::cerr));

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "granmem/core/error.hpp"
+#include "granmem/sim/spatial_order.hpp"
 
 namespace granmem {
 
@@ -122,6 +123,7 @@ Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, Depos
     sim.refresh_forces();
     settling += settle(sim, o, "under the lid", progress);
   }
+  sim = in_spatial_order(sim);
   if (summary) {
     summary->lid_height = packing_height(sim);
     summary->packing_fraction = packing_fraction(sim);

@@ -12,7 +12,8 @@ namespace granmem {
 
 // Preparing a packing: grains inserted without overlap on a loose jittered lattice in the
 // (tall) box, falling and settling under gravity, then the lid placed on top and the
-// packing settled again. A seed makes it reproducible.
+// packing settled again; the settled grains are relabelled in spatial order
+// (in_spatial_order: neighbours get near ids). A seed makes it reproducible.
 struct DepositOptions {
   std::int64_t grains = 2000;
   double radius = 0.0025;     // m (0.5 cm grains)

@@ -156,6 +156,10 @@ class Simulation {
                    const Planes& planes);
   void finish_grain(std::size_t i, const PendingGrain& p, const Planes& planes, bool commit,
                     Eigen::Vector3d& f, Eigen::Vector3d& t);
+  // Grain at rank r waits for the batch, its pairs from lane first_lane on.
+  static void wait_for_lanes(std::vector<PendingGrain>& pending, std::size_t r,
+                             std::uint32_t outgoing, int first_lane);
+  void prefetch_wall_springs(std::size_t i) const;
   void add_walls(std::size_t i, const Planes& planes, bool commit, Eigen::Vector3d& f,
                  Eigen::Vector3d& t);
 

@@ -155,13 +155,10 @@ std::vector<fs::path> plot_fields(const fs::path& dir, const std::string& name,
   // One colour scale for all panels: up to the 98th percentile, so that a few grains at the
   // wall do not wash the pattern out.
   std::vector<double> all;
-  for (const Field& f : panels) {
-    for (double v : f.value)
-      if (std::isfinite(v)) all.push_back(v);
-  }
+  for (const Field& f : panels)
+    all.insert(all.end(), f.value.begin(), f.value.end());
+  const double top = quantile_in_place(all, 0.98);
   if (all.empty()) throw Error(name + ": no values to draw");
-  std::sort(all.begin(), all.end());
-  const double top = all[std::size_t(0.98 * double(all.size() - 1))];
   std::ostringstream data, plot;
   data.precision(8);
   plot << "set multiplot layout 1," << panels.size() << "\nset size ratio -1\nunset key\n"

@@ -12,6 +12,7 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/random.hpp"
+#include "granmem/core/statistics.hpp"
 
 namespace granmem {
 namespace {
@@ -220,14 +221,6 @@ std::string format_number(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", x);
   return text;
-}
-
-double quantile(std::vector<double> v, double p) {
-  std::sort(v.begin(), v.end());
-  const double x = p * double(v.size() - 1);
-  const std::size_t i = std::size_t(x);
-  if (i + 1 >= v.size()) return v.back();
-  return v[i] + (x - double(i)) * (v[i + 1] - v[i]);
 }
 
 }  // namespace

@@ -8,16 +8,28 @@
 
 namespace granmem {
 
-double median(std::vector<double> values) {
+double quantile_in_place(std::vector<double>& values, double p) {
   values.erase(
       std::remove_if(values.begin(), values.end(), [](double x) { return !std::isfinite(x); }),
       values.end());
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const std::size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(mid), values.end());
-  const double upper = values[mid];
-  if (values.size() % 2 == 1) return upper;
-  return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + std::ptrdiff_t(mid)));
+  const double at = std::clamp(p, 0.0, 1.0) * double(values.size() - 1);
+  const auto i = std::size_t(at);
+  const double f = at - double(i);
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(i), values.end());
+  const double lower = values[i];
+  if (f == 0) return lower;
+  const double upper = *std::min_element(values.begin() + std::ptrdiff_t(i) + 1, values.end());
+  // (1 - f) lower + f upper: at f = 1/2 exactly half the sum of the middle two.
+  return (1 - f) * lower + f * upper;
+}
+
+double quantile(std::vector<double> values, double p) {
+  return quantile_in_place(values, p);
+}
+
+double median(std::vector<double> values) {
+  return quantile_in_place(values, 0.5);
 }
 
 double bootstrap_standard_error(const std::vector<double>& values, std::size_t resamples,

@@ -250,5 +250,31 @@ TEST(BootstrapStandardError, IsSigmaOverRootNForIndependentValues) {
   EXPECT_TRUE(std::isnan(bootstrap_standard_error({1.0}, 100, resample)));
 }
 
+// numpy.quantile's default (linear interpolation between order statistics).
+TEST(Quantile, InterpolatesBetweenOrderStatisticsAsNumpyDoes) {
+  const std::vector<double> v = {4, 1, 3, 2};
+  EXPECT_EQ(quantile(v, 0.0), 1.0);
+  EXPECT_EQ(quantile(v, 1.0), 4.0);
+  EXPECT_DOUBLE_EQ(quantile(v, 0.25), 1.75);  // numpy.quantile([1, 2, 3, 4], 0.25)
+  EXPECT_EQ(quantile(v, 0.5), 2.5);
+  EXPECT_EQ(median(v), 2.5);
+  std::vector<double> eleven;
+  for (int k = 11; k >= 1; --k)
+    eleven.push_back(k);
+  EXPECT_EQ(quantile(eleven, 0.9), 10.0);  // exactly on an order statistic
+  EXPECT_DOUBLE_EQ(quantile(eleven, 0.98), 10.8);
+}
+
+TEST(Quantile, IgnoresNonFiniteValuesAndIsNanWithoutAny) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> v = {nan, 5, inf, 1, 3};
+  EXPECT_EQ(quantile(v, 0.5), 3.0);
+  EXPECT_EQ(quantile_in_place(v, 1.0), 5.0);
+  EXPECT_EQ(v.size(), 3u);  // the in-place form drops them
+  EXPECT_TRUE(std::isnan(quantile({nan, inf}, 0.5)));
+  EXPECT_TRUE(std::isnan(quantile({}, 0.5)));
+}
+
 }  // namespace
 }  // namespace granmem

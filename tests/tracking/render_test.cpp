@@ -431,12 +431,14 @@ TEST(Render, StackAroundTheGrainsWhenNotGiven) {
   o.margin = 3;
   std::vector<RenderedGrain> grains = a_few_grains();
   const ScanGeometry g = scan_geometry(grains, o);
-  // Median diameter over 20 px.
+  // Median diameter over 20 px (the mean of the middle two radii for an even count).
   std::vector<double> r;
   for (const auto& grain : grains)
     r.push_back(grain.radius);
   std::sort(r.begin(), r.end());
-  EXPECT_DOUBLE_EQ(g.voxel_size.x(), 2 * r[r.size() / 2] / 20);
+  const double median_r =
+      r.size() % 2 ? r[r.size() / 2] : 0.5 * (r[r.size() / 2 - 1] + r[r.size() / 2]);
+  EXPECT_DOUBLE_EQ(g.voxel_size.x(), 2 * median_r / 20);
   EXPECT_DOUBLE_EQ(g.voxel_size.z(), g.voxel_size.x());
   for (const auto& grain : grains) {
     const Eigen::Vector3d c = g.to_voxels(grain.centre);

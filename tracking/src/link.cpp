@@ -11,6 +11,7 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/point_index.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/tracking/assignment.hpp"
 
 // Why this method holds in dense packings
@@ -52,14 +53,6 @@ constexpr std::size_t kParallel = 2000;  // fewer grains than this: one thread
 constexpr double kDefaultReach = 0.7;
 
 using Hits = PointIndex::Hits;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return kNaN;
-  const auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  if (v.size() % 2) return *mid;
-  return 0.5 * (*mid + *std::max_element(v.begin(), mid));
-}
 
 Vectors3 to_rows(const std::vector<Eigen::Vector3d>& points) {
   Vectors3 m(Eigen::Index(points.size()), 3);

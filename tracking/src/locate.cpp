@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/rotation/hole_contacts.hpp"
 #include "granmem/tracking/candidates.hpp"
 #include "granmem/tracking/grain_fit.hpp"
@@ -402,10 +403,7 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
         g.push_back(refits[k].grain - f.grain);
       }
       if (a.empty()) break;  // no refit converged: the sample's refits stand
-      const auto median = [](std::vector<double>& v) {
-        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-        return v[v.size() / 2];
-      };
+      const auto median = [](std::vector<double>& v) { return quantile_in_place(v, 0.5); };
       across = median(a);
       along_z = median(z);
       shortfall = median(r);

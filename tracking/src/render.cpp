@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/tracking/partial_volume.hpp"
 #include "seeded_random.hpp"
 
@@ -245,8 +246,7 @@ ScanGeometry scan_geometry(const std::vector<RenderedGrain>& grains, const Rende
     std::vector<double> radii;
     for (const RenderedGrain& grain : grains)
       radii.push_back(grain.radius);
-    std::nth_element(radii.begin(), radii.begin() + radii.size() / 2, radii.end());
-    const double pixel = 2 * radii[radii.size() / 2] / options.diameter_px;
+    const double pixel = 2 * median(radii) / options.diameter_px;
     g.voxel_size = Eigen::Vector3d(pixel, pixel, pixel * options.slice_spacing_ratio);
   }
   if (options.origin && options.size) {

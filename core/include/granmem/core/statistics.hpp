@@ -20,8 +20,15 @@ struct Summary {
 };
 Summary summarize(const std::vector<double>& values);
 
-// The median of the finite values (the mean of the middle two for an even count); NaN if
-// there are none.
+// The p-quantile (0 <= p <= 1) of the finite values: linear interpolation between the
+// order statistics around p (n - 1) (numpy's default), so p = 0.5 is the median, the mean
+// of the middle two for an even count; NaN if there are none. granmem's one convention for
+// medians, percentiles and quantiles.
+double quantile(std::vector<double> values, double p);
+// The same in O(n) on the caller's vector, which loses its non-finite values and its
+// order (for large samples, e.g. a slice's voxels).
+double quantile_in_place(std::vector<double>& values, double p);
+// quantile(values, 0.5).
 double median(std::vector<double> values);
 
 // The standard error of the mean of the finite values, from `resamples` bootstrap draws of

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <string>
 #include <tuple>
 #include <unordered_map>
+
+#include "granmem/core/error.hpp"
 
 namespace granmem {
 namespace {
@@ -30,6 +33,11 @@ std::vector<std::size_t> layer_order(const Grains& g) {
 
 Simulation in_spatial_order(const Simulation& sim) {
   const Grains& g = sim.grains();
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (!g.x[i].allFinite()) {  // no order to sort by (and NaN keys would break the sort)
+      throw Error("spatial order: grain " + std::to_string(g.id[i]) + " has no finite position");
+    }
+  }
   const std::vector<std::size_t> order = layer_order(g);
   Grains out;
   std::unordered_map<std::int64_t, std::int64_t> new_id;

@@ -9,6 +9,7 @@
 #include <map>
 #include <random>
 
+#include "granmem/core/error.hpp"
 #include "sim_checks.hpp"
 
 namespace granmem {
@@ -109,6 +110,19 @@ TEST(SpatialOrder, TheContinuationIsTheSamePhysics) {
   EXPECT_GT(moved, 1e-6);  // the grains do move
   EXPECT_LT(worst, 1e-12);
   EXPECT_EQ(a.contact_count(), b.contact_count());
+}
+
+TEST(SpatialOrder, AGrainWithoutAFinitePositionIsRefused) {
+  Grains g = testing::lattice_cluster(2, 2, 2, 1.2, 1);
+  g.x[3].y() = std::nan("");
+  const Simulation sim(g, testing::wide_box(1.0), PhysicsOptions{});
+  try {
+    in_spatial_order(sim);
+    FAIL() << "accepted a NaN position";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("grain 33 has no finite position"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -11,7 +11,8 @@ namespace granmem {
 // forces, every contact's and wall contact's springs, the container, time and step count
 // are carried over: the continuation is the same physics, though not the same bits (each
 // grain's forces are summed in the order of the new ids). Threads as the simulation had;
-// the wall's motion is not carried (set it again).
+// the wall's motion is not carried (set it again). Throws Error for a grain whose position
+// is not finite.
 Simulation in_spatial_order(const Simulation& sim);
 
 }  // namespace granmem

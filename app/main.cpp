@@ -2,13 +2,15 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "git_commit.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/version.hpp"
 #include "simulation_settings.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"granmem: tracked grains and DEM runs of cyclically compressed packings"};
-  app.set_version_flag("--version", granmem::kVersion);
+  app.set_version_flag("--version", std::string("granmem ") + granmem::kVersion + " (commit " +
+                                        granmem::kGitCommit + ")");
   app.set_config("--config", "", "TOML file of options, one [section] per command");
   app.require_subcommand(1);
   app.fallthrough();                                        // --config may follow the command name
@@ -36,7 +38,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);  // a CLI::RuntimeError (e.g. an interrupted run) prints nothing
+    // --help and --version exit 0, an interrupted run (a CLI::RuntimeError, which prints
+    // nothing) with its own code, a usage error 2 as Unix tools do.
+    const int code = app.exit(e);
+    const bool usage_error = code != 0 && dynamic_cast<const CLI::RuntimeError*>(&e) == nullptr;
+    return usage_error ? 2 : code;
   } catch (const std::exception& e) {
     std::cerr << "granmem: error: " << e.what() << "\n";
     return 1;

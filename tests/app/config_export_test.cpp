@@ -138,9 +138,11 @@ const char* kExportTable =
 TEST_F(GranmemTest, InfoNamesFramesGrainsUnitsAndDatasets) {
   write_text(in_work("t.csv"), kExportTable);
   granmem_ok({"import", "t.csv", "--out", "run.h5", "--length-unit", "mm"});
-  std::string version = granmem_ok({"--version"}).out;
-  while (!version.empty() && version.back() == '\n')
-    version.pop_back();
+  // `granmem --version`: "granmem 0.1.0 (commit ...)"; the store names the release.
+  std::istringstream said(granmem_ok({"--version"}).out);
+  std::string name, version;
+  said >> name >> version;
+  ASSERT_EQ(name, "granmem");
   ASSERT_FALSE(version.empty());
 
   const RunResult r = granmem_ok({"info", "run.h5"});

@@ -254,6 +254,7 @@ int time_run(const std::vector<std::string>& a) {
   const double t0 = sim.time();
   sim.set_wall_motion(
       [drive, t0](double t) { return drive.at(std::clamp(t - t0, 0.0, drive.period)); });
+  const std::int64_t builds_before = sim.neighbor_builds();
   const auto start = Clock::now();
   sim.run(steps);
   const double wall = seconds_since(start);
@@ -270,6 +271,7 @@ int time_run(const std::vector<std::string>& a) {
             << " ke_per_grain_erg=" << sim.kinetic_energy() / n * 1e7
             << " min_grain_y_cm=" << y_min / kCm
             << " contacts_per_grain=" << 2.0 * double(sim.contact_count()) / n
+            << " neighbor_builds=" << sim.neighbor_builds() - builds_before
             << " steps_per_cycle_paper=" << paper_steps_per_cycle(sim) << "\n";
   return 0;
 }

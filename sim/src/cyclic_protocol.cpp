@@ -41,6 +41,8 @@ namespace {
 constexpr const char* kEnd = "end_of_cycle";
 constexpr const char* kFull = "full_compression";
 constexpr const char* kInCycle = "in_cycle";
+// Most steps run between two looks at the stop flag and the progress clock.
+constexpr std::int64_t kStepsPerRun = 256;
 
 RunHeader header_for(const Simulation& sim, const std::vector<std::size_t>& grains,
                      const char* sample, const std::map<std::string, std::string>& parameters) {
@@ -260,8 +262,10 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
   // The wall follows the drive by step count, so that a resumed run moves it identically;
   // step k of n is at k/n of the period, so that a cycle ends exactly where it began. The
   // motion refers to this function's locals: it is removed however the function ends.
+  std::int64_t cycle_start = 0;  // the simulation's step count where this cycle began
   sim.set_wall_motion([&](double) {
-    return drive.at(drive.period * double(state.step_in_cycle + 1) / double(steps_per_cycle));
+    return drive.at(drive.period * double(sim.step_count() - cycle_start) /
+                    double(steps_per_cycle));
   });
   struct ClearWallMotion {
     Simulation& sim;
@@ -277,15 +281,21 @@ CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState&
         summary.cycles_done = state.cycles_done;
         return summary;
       }
-      sim.step();
-      ++state.step_in_cycle;
-      ++steps_run;
+      // Steps in one run up to the next that is read (a run saves a pass per step).
+      std::int64_t next = state.step_in_cycle + 1;
+      while (next < steps_per_cycle && next - state.step_in_cycle < kStepsPerRun &&
+             next != full_step && !sample_due(next))
+        ++next;
+      cycle_start = sim.step_count() - state.step_in_cycle;
+      sim.run(next - state.step_in_cycle);
+      steps_run += next - state.step_in_cycle;
+      state.step_in_cycle = next;
       if (state.step_in_cycle == full_step) {
         state.pending["wall_force_full_compression"] = driven_wall_force(sim);
         if (o.full_compression_frames) append(kFull, state.cycles_done + 1);
       }
       if (sample_due(state.step_in_cycle)) append(kInCycle, sim.step_count());
-      if ((steps_run & 255) == 0) report(false);
+      report(false);
     }
     ++state.cycles_done;
     state.step_in_cycle = 0;

@@ -16,7 +16,7 @@ namespace {
 // step, so this is exact). For the small turns of a step, sin and cos of the half angle
 // come from their series, exact to double precision below 1e-2 rad; by multiplications
 // (a division costs as much as the rest of the step's integration).
-Eigen::Quaterniond turned(const Eigen::Quaterniond& q, const Eigen::Vector3d& turn) {
+GRANMEM_INLINE Eigen::Quaterniond turned(const Eigen::Quaterniond& q, const Eigen::Vector3d& turn) {
   const double angle_sq = turn.squaredNorm();
   if (angle_sq == 0) return q;
   double c, s_over_angle;  // cos(angle/2), sin(angle/2)/angle
@@ -33,7 +33,11 @@ Eigen::Quaterniond turned(const Eigen::Quaterniond& q, const Eigen::Vector3d& tu
   }
   const Eigen::Vector3d v = s_over_angle * turn;
   Eigen::Quaterniond out = Eigen::Quaterniond(c, v.x(), v.y(), v.z()) * q;
-  out.coeffs() *= 1 / out.coeffs().norm();
+  // Back to unit length: q is a unit to rounding, and so 1/sqrt(n2) = 1 - (n2 - 1)/2 to
+  // O((n2 - 1)^2) (below rounding here), without the square root and division that held
+  // up the step.
+  const double n2 = out.coeffs().squaredNorm();
+  out.coeffs() *= std::abs(n2 - 1) < 1e-8 ? 1.5 - 0.5 * n2 : 1 / std::sqrt(n2);
   return out;
 }
 
@@ -115,6 +119,7 @@ void Simulation::rebuild_neighbors() {
   pair_history_ = next.carry(neighbors_, pair_history_, grains_.id, ContactHistory{});
   touching_ = next.carry(neighbors_, touching_, grains_.id, std::uint8_t{0});
   neighbors_ = std::move(next);
+  ++neighbor_builds_;
   pair_force_.resize(neighbors_.pair_count());
   active_.assign(neighbors_.pair_count(), 0);
 }
@@ -279,11 +284,15 @@ void Simulation::add_incoming(Share s) {
   }
 }
 
-void Simulation::finish_sums(Share s, bool commit, PairLanes& lanes) {
-  Planes planes;
-  planes.count = container_.lid.present ? kWallCount : kWallCount - 1;
-  for (int w = 0; w < planes.count; ++w)
-    planes.plane[w] = container_.plane(static_cast<Wall>(w));
+Simulation::Pass Simulation::pass(bool commit, bool drift) const {
+  Pass p{commit, drift && commit, {}, false};
+  p.planes.count = container_.lid.present ? kWallCount : kWallCount - 1;
+  for (int w = 0; w < p.planes.count; ++w)
+    p.planes.plane[w] = container_.plane(static_cast<Wall>(w));
+  return p;
+}
+
+void Simulation::finish_sums(Share s, Pass& pass, PairLanes& lanes) {
   const auto& partner = neighbors_.partner();
   std::vector<PendingGrain> pending;
   pending.reserve(kPendingGrains + 1);
@@ -293,24 +302,23 @@ void Simulation::finish_sums(Share s, bool commit, PairLanes& lanes) {
     wait_for_lanes(pending, r, outgoing, lanes.count);
     prefetch_wall_springs(i);
     for (std::uint32_t k = neighbors_.begin(i); k < outgoing; ++k) {
-      if (!touching(i, k, commit)) continue;
+      if (!touching(i, k, pass.commit)) continue;
       add_pair(lanes, k, i, partner[k]);
       if (lanes.full()) {
         pending.back().last_lane = lanes.count;
-        sum_pending(commit, lanes, pending, planes);
+        sum_pending(pass, lanes, pending);
         wait_for_lanes(pending, r, outgoing, 0);
       }
     }
     pending.back().last_lane = lanes.count;
     pending.back().complete = true;
-    if (pending.size() >= kPendingGrains) sum_pending(commit, lanes, pending, planes);
+    if (pending.size() >= kPendingGrains) sum_pending(pass, lanes, pending);
   }
-  sum_pending(commit, lanes, pending, planes);
+  sum_pending(pass, lanes, pending);
 }
 
-void Simulation::sum_pending(bool commit, PairLanes& lanes, std::vector<PendingGrain>& pending,
-                             const Planes& planes) {
-  evaluate_lanes(lanes, commit);
+void Simulation::sum_pending(Pass& pass, PairLanes& lanes, std::vector<PendingGrain>& pending) {
+  evaluate_lanes(lanes, pass.commit);
   Grains& g = grains_;
   const auto& partner = neighbors_.partner();
   for (const PendingGrain& p : pending) {
@@ -331,7 +339,7 @@ void Simulation::sum_pending(bool commit, PairLanes& lanes, std::vector<PendingG
       g.torque[j] += Eigen::Vector3d(lanes.torque_on_j[0][l], lanes.torque_on_j[1][l],
                                      lanes.torque_on_j[2][l]);
     }
-    if (p.complete) finish_grain(i, p, planes, commit, f, t);
+    if (p.complete) finish_grain(i, p, pass, f, t);
     g.force[i] = f;
     g.torque[i] = t;
   }
@@ -339,22 +347,38 @@ void Simulation::sum_pending(bool commit, PairLanes& lanes, std::vector<PendingG
   pending.clear();
 }
 
-GRANMEM_INLINE void Simulation::finish_grain(std::size_t i, const PendingGrain& p,
-                                             const Planes& planes, bool commit, Eigen::Vector3d& f,
-                                             Eigen::Vector3d& t) {
-  Grains& g = grains_;
-  // The pairs whose partner is in a later share (partners of larger id than any in it).
+// Grain i's sum is made once its pairs beyond the share and its walls are added; nothing
+// later in the pass reads its position or velocity (its partners in the share have larger
+// ids, and those in other shares were evaluated before the barrier).
+GRANMEM_INLINE void Simulation::finish_grain(std::size_t i, const PendingGrain& p, Pass& pass,
+                                             Eigen::Vector3d& f, Eigen::Vector3d& t) {
   for (std::uint32_t k = p.outgoing; k < neighbors_.end(i); ++k) {
     if (!active_[k]) continue;
     f += pair_force_[k].force_on_i;
     t += pair_force_[k].torque_on_i;
   }
-  add_walls(i, planes, commit, f, t);
-  if (commit) {  // the step's second half kick, while the grain is at hand
-    const double half_dt = 0.5 * physics_.dt;
-    g.v[i] += half_dt * g.inv_mass[i] * f;
-    g.w[i] += half_dt * g.inv_inertia[i] * t;
-  }
+  add_walls(i, pass.planes, pass.commit, f, t);
+  if (!pass.commit) return;
+  half_kick(i, f, t);  // the step's second half kick, while the grain is at hand
+  if (!pass.drift) return;
+  half_kick(i, f, t);  // and the next step's first half
+  if (drift(i)) pass.moved_too_far = true;
+}
+
+GRANMEM_INLINE void Simulation::half_kick(std::size_t i, const Eigen::Vector3d& force,
+                                          const Eigen::Vector3d& torque) {
+  Grains& g = grains_;
+  const double half_dt = 0.5 * physics_.dt;
+  g.v[i] += half_dt * g.inv_mass[i] * force;
+  g.w[i] += half_dt * g.inv_inertia[i] * torque;
+}
+
+GRANMEM_INLINE bool Simulation::drift(std::size_t i) {
+  Grains& g = grains_;
+  const double dt = physics_.dt;
+  g.x[i] += dt * g.v[i];
+  g.q[i] = turned(g.q[i], g.w[i] * dt);
+  return neighbors_.moved_too_far(g.x[i], i);
 }
 
 // Each grain's forces are summed in the order of its partners' ids: gravity and drag, the
@@ -365,11 +389,13 @@ GRANMEM_INLINE void Simulation::finish_grain(std::size_t i, const PendingGrain& 
 // made from it, each reaction added at once to its partner (no pair force is stored);
 // across shares, the pairs are evaluated first and their reactions added before the
 // share's own (their owners' ids are smaller than any in the share).
-void Simulation::compute_forces(bool commit) {
-#pragma omp parallel num_threads(threads_)
+bool Simulation::compute_forces(bool commit, bool drift) {
+  bool moved_too_far = false;
+#pragma omp parallel num_threads(threads_) reduction(|| : moved_too_far)
   {
     const int threads = omp_get_num_threads();
     const Share s = share(omp_get_thread_num(), threads);
+    Pass p = pass(commit, drift);
     PairLanes lanes;
     start_sums(s);
     if (threads > 1) {
@@ -377,9 +403,11 @@ void Simulation::compute_forces(bool commit) {
 #pragma omp barrier
       add_incoming(s);
     }
-    finish_sums(s, commit, lanes);
+    finish_sums(s, p, lanes);
+    moved_too_far = p.moved_too_far;
   }
   sum_wall_loads();
+  return moved_too_far;
 }
 
 void Simulation::sum_wall_loads() {
@@ -402,22 +430,23 @@ void Simulation::sum_wall_loads() {
   }
 }
 
-void Simulation::step() {
-  const double dt = physics_.dt, half = 0.5 * dt;
+bool Simulation::kick_and_drift_all() {
   Grains& g = grains_;
   const std::size_t n = g.size();
-  bool stale = false;
-#pragma omp parallel for schedule(static) reduction(|| : stale) num_threads(threads_)
+  bool moved_too_far = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved_too_far) num_threads(threads_)
   for (std::size_t i = 0; i < n; ++i) {
-    g.v[i] += half * g.inv_mass[i] * g.force[i];
-    g.w[i] += half * g.inv_inertia[i] * g.torque[i];
-    g.x[i] += dt * g.v[i];
-    g.q[i] = turned(g.q[i], g.w[i] * dt);
-    stale = stale || neighbors_.moved_too_far(g.x[i], i);
+    half_kick(i, g.force[i], g.torque[i]);
+    if (drift(i)) moved_too_far = true;
   }
+  return moved_too_far;
+}
+
+void Simulation::advance_walls() {
+  const double dt = physics_.dt;
   Lid& lid = container_.lid;
   if (lid.present) {
-    lid.v += half * lid.force / lid.mass;
+    lid.v += 0.5 * dt * lid.force / lid.mass;
     lid.z += dt * lid.v;
   }
   time_ += dt;
@@ -425,15 +454,22 @@ void Simulation::step() {
   if (wall_motion_) {
     std::tie(container_.y_wall, container_.y_wall_velocity) = wall_motion_(time_);
   }
-  if (stale) rebuild_neighbors();
-
-  compute_forces(true);  // and the grains' second half kick
-  if (lid.present) lid.v += half * lid.force / lid.mass;
 }
 
+// Each step: the grains' first half (half kick, drift, turn), the lid's and the drive's,
+// a new neighbour list if a grain left its reach, the force pass with the grains' second
+// half kick, the lid's. Within a run the next step's first half for the grains is done in
+// the force pass, which saves a pass over every grain.
 void Simulation::run(std::int64_t steps) {
-  for (std::int64_t s = 0; s < steps; ++s)
-    step();
+  if (steps <= 0) return;
+  bool stale = kick_and_drift_all();
+  for (std::int64_t s = 0; s < steps; ++s) {
+    advance_walls();
+    if (stale) rebuild_neighbors();
+    stale = compute_forces(true, s + 1 < steps);
+    Lid& lid = container_.lid;
+    if (lid.present) lid.v += 0.5 * physics_.dt * lid.force / lid.mass;
+  }
 }
 
 std::size_t Simulation::contact_count() const {

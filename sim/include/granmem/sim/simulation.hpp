@@ -58,11 +58,15 @@ class Simulation {
  public:
   Simulation(Grains grains, Container container, PhysicsOptions physics);
 
-  // The driven wall's position and velocity at time t; default: at rest where it is.
+  // The driven wall's position and velocity at time t, asked once a step after time() and
+  // step_count() have advanced to the step's end; default: at rest where it is.
   using WallMotion = std::function<std::pair<double, double>(double t)>;
   void set_wall_motion(WallMotion motion) { wall_motion_ = std::move(motion); }
 
-  void step();
+  // Steps of velocity Verlet. Between two steps of one run() the grains are in mid-step
+  // (the next step's first half is done in the force pass); after it they are at its end,
+  // and run(n) gives the same state, bit for bit, as n calls of step().
+  void step() { run(1); }
   void run(std::int64_t steps);
 
   // OpenMP threads: 0 (the default) uses one per 2,500 grains, up to omp_get_max_threads(),
@@ -73,6 +77,9 @@ class Simulation {
 
   double time() const { return time_; }
   std::int64_t step_count() const { return step_count_; }
+  // Neighbour lists built so far (one when constructed, one each time a grain has moved
+  // half the skin since the last).
+  std::int64_t neighbor_builds() const { return neighbor_builds_; }
   const Grains& grains() const { return grains_; }
   Grains& grains() { return grains_; }
   const Container& container() const { return container_; }
@@ -108,8 +115,17 @@ class Simulation {
 
  private:
   // Forces and torques at the current positions. With `commit`, a step's: contact
-  // histories are stored and the grains get the second half kick.
-  void compute_forces(bool commit);
+  // histories are stored and the grains get the second half kick; with `drift` too, each
+  // grain then gets the first half of the next step as soon as its sum is made (its
+  // position is not read again in the pass). Returns whether a grain drifted beyond the
+  // neighbour list's reach.
+  bool compute_forces(bool commit, bool drift = false);
+  // The first half of a step for every grain (half kick, drift, turn); the same return.
+  bool kick_and_drift_all();
+  void half_kick(std::size_t i, const Eigen::Vector3d& force, const Eigen::Vector3d& torque);
+  bool drift(std::size_t i);  // whether grain i left the neighbour list's reach
+  // The lid's and the drive's part of a step, between two force passes.
+  void advance_walls();
   void rebuild_neighbors();
 
   struct PairForce {
@@ -123,7 +139,18 @@ class Simulation {
   // The stages of compute_forces, over one share.
   void start_sums(Share s);
   void add_incoming(Share s);
-  void finish_sums(Share s, bool commit, PairLanes& lanes);
+  struct Planes {
+    std::array<Container::Plane, kWallCount> plane;
+    int count;
+  };
+  // What a pass does beyond the sums (see compute_forces), and what it found.
+  struct Pass {
+    bool commit, drift;
+    Planes planes;
+    bool moved_too_far = false;
+  };
+  Pass pass(bool commit, bool drift) const;
+  void finish_sums(Share s, Pass& pass, PairLanes& lanes);
   void sum_wall_loads();
   // Pair k, owned by grain i: whether its grains overlap. One that does not forgets its
   // springs (with `commit`).
@@ -145,17 +172,12 @@ class Simulation {
     int first_lane, last_lane;
     bool complete;
   };
-  struct Planes {
-    std::array<Container::Plane, kWallCount> plane;
-    int count;
-  };
   // Evaluates the batch and makes the pending grains' sums in id order: a grain's pairs in
   // the share, each reaction added at once to its partner, then (complete grains) its
-  // pairs beyond the share, its walls and, with `commit`, its second half kick.
-  void sum_pending(bool commit, PairLanes& lanes, std::vector<PendingGrain>& pending,
-                   const Planes& planes);
-  void finish_grain(std::size_t i, const PendingGrain& p, const Planes& planes, bool commit,
-                    Eigen::Vector3d& f, Eigen::Vector3d& t);
+  // pairs beyond the share, its walls and what the pass does with a finished grain.
+  void sum_pending(Pass& pass, PairLanes& lanes, std::vector<PendingGrain>& pending);
+  void finish_grain(std::size_t i, const PendingGrain& p, Pass& pass, Eigen::Vector3d& f,
+                    Eigen::Vector3d& t);
   // Grain at rank r waits for the batch, its pairs from lane first_lane on.
   static void wait_for_lanes(std::vector<PendingGrain>& pending, std::size_t r,
                              std::uint32_t outgoing, int first_lane);
@@ -187,6 +209,7 @@ class Simulation {
   double uniform_sqrt_reduced_mass_ = 0;  // > 0 when every grain has the same mass
   double time_ = 0;
   std::int64_t step_count_ = 0;
+  std::int64_t neighbor_builds_ = 0;
 };
 
 }  // namespace granmem

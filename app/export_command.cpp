@@ -1,6 +1,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/particle_dump.hpp"
 
@@ -19,6 +20,7 @@ void add_export(CLI::App& app) {
   cmd->add_option("--format", args->format, "lammps or extxyz; default from the file name")
       ->check(CLI::IsMember({"lammps", "extxyz"}));
   cmd->callback([args] {
+    check_outputs({{"--out", args->out}}, {{"run", args->run}});
     std::string format = args->format;
     if (format.empty()) {
       const std::string ext = std::filesystem::path(args->out).extension().string();

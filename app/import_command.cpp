@@ -1,6 +1,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/import_table.hpp"
 #include "granmem/core/trajectory_store.hpp"
@@ -38,6 +39,8 @@ void add_import(CLI::App& app) {
       ->capture_default_str();
 
   cmd->callback([args, cmd, radius] {
+    check_outputs({{"--out", args->out}, {"--out's XDMF", xdmf_path(args->out)}},
+                  {{"table", args->table}});
     ImportOptions options;
     options.length_unit = args->length_unit;
     if (radius->count()) options.radius = args->radius;

@@ -73,6 +73,12 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
                   "CSV of what could not be linked: tracks lost and detections starting a track");
 }
 
+std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out) {
+  std::vector<NamedPath> outputs{{"--out", out}, {"--out's XDMF", xdmf_path(out)}};
+  if (!args.report.empty()) outputs.push_back({"--report", args.report});
+  return outputs;
+}
+
 void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
                     const LinkArgs& args, const std::string& out, const CLI::App& cmd) {
   // Detections located one stack at a time all say frame 0: number them as given.
@@ -113,7 +119,7 @@ void link_and_write(std::vector<Detections> scans, const std::vector<std::string
   std::optional<AtomicFile> report;
   if (!args.report.empty()) {
     report.emplace(args.report);
-    write_csv(unlinked_table(run, summary, scans), report->temp_path(),
+    write_csv(unlinked_table(run, summary, scans), *report,
               {"granmem link: what could not be linked, lengths in " + unit,
                "lost=1: track seen in the scan before (at x,y,z) and not found in this frame",
                "lost=0: detection of this frame starting a new track"});
@@ -164,6 +170,10 @@ void add_link(CLI::App& app) {
   cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
   add_link_options(cmd, args->link);
   cmd->callback([args, cmd] {
+    std::vector<NamedPath> inputs;
+    for (const std::string& path : args->scans)
+      inputs.push_back({"scan", path});
+    check_outputs(link_outputs(args->link, args->out), inputs);
     std::vector<Detections> scans;
     scans.reserve(args->scans.size());
     for (const std::string& path : args->scans) {

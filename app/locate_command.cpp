@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/locate.hpp"
@@ -153,7 +154,9 @@ void add_locate(CLI::App& app) {
       ->capture_default_str();
   add_locate_options(cmd, args->locate);
   cmd->callback([args] {
-    if (!args->csv.empty() && args->csv == args->out) throw Error("--csv and --out name one file");
+    std::vector<NamedPath> outputs{{"--out", args->out}};
+    if (!args->csv.empty()) outputs.push_back({"--csv", args->csv});
+    check_outputs(outputs, {{"stack", args->stack}});
     const Detections d = locate_scan(args->stack, args->locate, args->frame);
     write_detections(d, args->out);
     if (!args->csv.empty()) write_detections(d, args->csv);
@@ -186,15 +189,26 @@ void add_track(CLI::App& app) {
   cmd->callback([args, cmd] {
     std::vector<std::string> scans = args->scans;
     std::stable_sort(scans.begin(), scans.end(), natural_less);
-    if (!args->detections.empty()) std::filesystem::create_directories(args->detections);
+    // Every scan there and every output safe to write, before the first is located.
+    auto detections_of = [&](const std::string& scan) {
+      const std::filesystem::path name = std::filesystem::path(scan).filename();
+      return std::filesystem::path(args->detections) / (name.stem().string() + ".h5");
+    };
+    std::vector<NamedPath> inputs, outputs = link_outputs(args->link, args->out);
+    for (const std::string& scan : scans) {
+      if (!std::filesystem::exists(scan)) throw Error("scan " + scan + ": no such file or folder");
+      inputs.push_back({"scan", scan});
+    }
+    if (!args->detections.empty()) {
+      std::filesystem::create_directories(args->detections);
+      for (const std::string& scan : scans)
+        outputs.push_back({"--detections of " + scan, detections_of(scan)});
+    }
+    check_outputs(outputs, inputs);
     std::vector<Detections> found;
     for (std::size_t k = 0; k < scans.size(); ++k) {
       found.push_back(locate_scan(scans[k], args->locate, std::int64_t(k)));
-      if (!args->detections.empty()) {
-        const std::filesystem::path name = std::filesystem::path(scans[k]).filename();
-        write_detections(found.back(),
-                         std::filesystem::path(args->detections) / (name.stem().string() + ".h5"));
-      }
+      if (!args->detections.empty()) write_detections(found.back(), detections_of(scans[k]));
     }
     link_and_write(std::move(found), scans, args->link, args->out, *cmd);
     if (!args->analyze.empty()) {

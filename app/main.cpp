@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
     const bool usage_error = code != 0 && dynamic_cast<const CLI::RuntimeError*>(&e) == nullptr;
     return usage_error ? 2 : code;
   } catch (const std::exception& e) {
-    std::cerr << "granmem: error: " << e.what() << "\n";
+    std::cerr << "granmem: error: " << granmem::one_printable_line(e.what()) << "\n";
     return 1;
   }
   return 0;

@@ -138,6 +138,9 @@ void add_render(CLI::App& app) {
 
   cmd->callback([args, cmd] {
     // Every option is checked, and the frame found, before anything is drawn or written.
+    std::vector<NamedPath> outputs{{"--out", args->out}};
+    if (!args->truth.empty()) outputs.push_back({"--truth", args->truth});
+    check_outputs(outputs, {{"run", args->run}});
     const TrajectoryReader run(args->run);
     const RunHeader& h = run.header();
     std::size_t index = run.frame_count();
@@ -226,7 +229,7 @@ void add_render(CLI::App& app) {
           "positions and radius in voxels of " + voxel.str() + "; voxel (0,0,0) is the origin"};
       for (const auto& [key, value] : used_options(*cmd))
         comment.push_back(key + " = " + value);
-      write_csv(truth, truth_file->temp_path(), comment);
+      write_csv(truth, *truth_file, comment);
     }
     write_tiff(stack, args->out);
     if (truth_file) truth_file->commit();

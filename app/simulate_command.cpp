@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
@@ -23,32 +24,13 @@
 namespace granmem::app {
 namespace {
 
+// Ctrl-C (SIGINT) and SIGTERM (what Slurm, systemd and container stops send) stop a run
+// between two steps with a checkpoint; the exit status is then 128 + the signal's number.
 std::atomic<bool> g_stop{false};
-extern "C" void request_stop(int) {
+std::atomic<int> g_stop_signal{0};
+extern "C" void request_stop(int signal) {
+  g_stop_signal.store(signal);
   g_stop.store(true);
-}
-
-// The files a run writes must be distinct, must not be the checkpoint it starts from, and
-// must go to folders that exist: checked before anything is computed.
-void check_outputs(const std::vector<std::filesystem::path>& outputs,
-                   const std::filesystem::path& source) {
-  namespace fs = std::filesystem;
-  std::vector<fs::path> seen;
-  for (const fs::path& p : outputs) {
-    const fs::path folder = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-    if (!fs::is_directory(folder)) {
-      throw Error(p.string() + ": folder '" + folder.string() + "' does not exist");
-    }
-    const fs::path full = fs::weakly_canonical(p);
-    if (!source.empty() && full == fs::weakly_canonical(source)) {
-      throw Error(p.string() + ": is the checkpoint this run starts from; choose another --out");
-    }
-    for (const fs::path& other : seen) {
-      if (full == other)
-        throw Error(p.string() + ": written twice by this run (--out, --checkpoint)");
-    }
-    seen.push_back(full);
-  }
 }
 
 // The options set on the command line or in the config.
@@ -165,12 +147,17 @@ SimulateSettings add_simulate(CLI::App& app) {
     c.keep_states = whole_list(v, "keep-states", "10,50,100");
     c.validate(box_y, physics.dt);
     {
-      std::vector<std::filesystem::path> outputs{c.out, c.checkpoint};
+      // The files a run writes: distinct, not the checkpoint it starts from, in folders
+      // that exist (--resume writes its own checkpoint again, by design).
+      std::vector<NamedPath> outputs{{"--out", c.out}, {"--checkpoint", c.checkpoint}};
       for (std::int64_t cycle : c.keep_states)
-        outputs.push_back(kept_state_path(c.out, cycle));
-      if (c.full_compression_frames) outputs.push_back(full_compression_path(c.out));
-      if (c.samples_per_cycle > 0) outputs.push_back(in_cycle_path(c.out));
-      check_outputs(outputs, *start_from);
+        outputs.push_back({"--keep-states", kept_state_path(c.out, cycle)});
+      if (c.full_compression_frames)
+        outputs.push_back({"--full-compression-frames", full_compression_path(c.out)});
+      if (c.samples_per_cycle > 0) outputs.push_back({"--samples-per-cycle", in_cycle_path(c.out)});
+      std::vector<NamedPath> inputs;
+      if (!start_from->empty()) inputs.push_back({"--start-from", *start_from});
+      check_outputs(outputs, inputs);
     }
 
     if (!sim) {
@@ -195,6 +182,7 @@ SimulateSettings add_simulate(CLI::App& app) {
               << c.drive.peak_speed() * 100 << " cm/s), " << c.cycles << " cycles\n";
 
     std::signal(SIGINT, request_stop);  // from here on, Ctrl-C writes a checkpoint
+    std::signal(SIGTERM, request_stop);
     const CyclicSummary summary = run_cycles(
         *sim, c, state,
         [](const CyclicProgress& p) {
@@ -208,7 +196,8 @@ SimulateSettings add_simulate(CLI::App& app) {
       std::cerr << "stopped after cycle " << summary.cycles_done << ": checkpoint " << checkpoint
                 << " (continue with --resume " << checkpoint << ")\n";
       std::signal(SIGINT, SIG_DFL);
-      throw CLI::RuntimeError(130);
+      std::signal(SIGTERM, SIG_DFL);
+      throw CLI::RuntimeError(128 + g_stop_signal.load());
     }
     std::cout << "simulated " << summary.cycles_done << " cycles of " << sim->grains().size()
               << " grains: " << std::scientific << std::setprecision(3)

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/locate.hpp"
 
@@ -29,6 +30,8 @@ struct LinkArgs {
   bool no_drift = false;
 };
 void add_link_options(CLI::App* cmd, LinkArgs& args);
+// The files linking writes: the store `out`, its XDMF and the --report.
+std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out);
 // Links the scans (`names` for messages), writes the trajectory store `out` with `cmd`'s
 // options as its parameters, and prints the per-scan summary.
 void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,

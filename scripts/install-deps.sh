@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libnanoflann-dev
   gnuplot-nox
   libopenmpi-dev openmpi-bin
+  lammps
 )
 
 missing=()

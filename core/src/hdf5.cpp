@@ -13,6 +13,14 @@ namespace {
 // HDF5 prints its error stack to stderr by default; granmem reports one line instead. The
 // setting is per thread in a thread-safe HDF5 (calibrate writes runs from several).
 void quiet_hdf5() {
+  // Once per process, before the library starts: no clean-up at exit. After a failed
+  // close (a full disk) HDF5 keeps the file in its tables and its exit handler crashes
+  // closing it again (HDF5 1.10); the operating system frees everything anyway.
+  static const bool once = [] {
+    H5dont_atexit();
+    return true;
+  }();
+  (void)once;
   thread_local const bool done = [] {
     H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
     return true;
@@ -110,13 +118,27 @@ void Handle::reset() {
   id_ = -1;
 }
 
+hid_t Handle::release() {
+  const hid_t id = id_;
+  id_ = -1;
+  return id;
+}
+
 File File::create(const std::filesystem::path& path) {
+  return create(path, path.string());
+}
+
+File File::create(const std::filesystem::path& path, const std::string& name) {
   quiet_hdf5();
   File f;
-  f.name_ = path.string();
-  f.handle_ = Handle(H5Fcreate(f.name_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
+  f.name_ = name;
+  f.handle_ = Handle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
   if (f.handle_.get() < 0) throw Error(f.name_ + ": cannot create HDF5 file");
   return f;
+}
+
+File File::create(const AtomicFile& file) {
+  return create(file.temp_path(), file.target().string());
 }
 
 File File::open(const std::filesystem::path& path) {
@@ -149,9 +171,10 @@ void File::flush() {
 
 void File::close() {
   if (handle_.get() < 0) return;
-  const herr_t flushed = H5Fflush(handle_.get(), H5F_SCOPE_GLOBAL);
-  const herr_t closed = H5Fclose(handle_.get());
-  handle_ = Handle();
+  // Closed once: after a failed close (a full disk) a second H5Fclose of the id crashes.
+  const hid_t id = handle_.release();
+  const herr_t flushed = H5Fflush(id, H5F_SCOPE_GLOBAL);
+  const herr_t closed = H5Fclose(id);
   if (flushed < 0 || closed < 0) throw Error(name_ + ": writing the HDF5 file failed (disk full?)");
 }
 

@@ -1,8 +1,11 @@
 #include "granmem/core/import_table.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <unordered_map>
 
 #include "granmem/core/error.hpp"
@@ -35,6 +38,39 @@ std::vector<std::int64_t> sorted_unique(std::vector<std::int64_t> v) {
 std::size_t index_of(const std::vector<std::int64_t>& sorted, std::int64_t value) {
   return static_cast<std::size_t>(std::lower_bound(sorted.begin(), sorted.end(), value) -
                                   sorted.begin());
+}
+
+// The store is a dense frames x particles array. A table whose labels barely repeat (a
+// 'particle' that is a row number, or a track id that changes every frame) would make a
+// store thousands of times its size: refused before anything is allocated, as is a store
+// beyond half of this machine's memory.
+void check_dense_size(const std::filesystem::path& csv, std::size_t rows, std::size_t frames,
+                      std::size_t particles) {
+  const double slots = double(frames) * double(particles);
+  const double bytes = slots * (3 + 3 + 2) * sizeof(double);  // positions, axes, rows, flags
+  const double filled = double(rows) / slots;
+  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
+  auto size = [](double b) {
+    std::ostringstream s;
+    s.precision(2);
+    s << b / (1 << 30) << " GiB";
+    return s.str();
+  };
+  const std::string shape = std::to_string(rows) + " rows label " + std::to_string(frames) +
+                            " frames x " + std::to_string(particles) + " particles";
+  if (slots > 1e6 && filled < 0.01) {
+    std::ostringstream fill;
+    fill.precision(2);
+    fill << 100 * filled;
+    throw Error(csv.string() + ": " + shape + ", of which " + fill.str() +
+                " % are in the table: is 'particle' a track id that is the same grain in every "
+                "frame? (the store holds every frame of every particle, " +
+                size(bytes) + ")");
+  }
+  if (memory > 0 && bytes > 0.5 * memory) {
+    throw Error(csv.string() + ": " + shape + ": the store would take " + size(bytes) +
+                ", more than half of this machine's " + size(memory));
+  }
 }
 
 }  // namespace
@@ -86,6 +122,7 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
   const std::vector<std::int64_t> frames = sorted_unique(frame_of);
   const std::vector<std::int64_t> particles = sorted_unique(particle_of);
   const std::size_t n = particles.size();
+  check_dense_size(csv, rows, frames.size(), n);
 
   Trajectories run;
   RunHeader& h = run.header;
@@ -134,7 +171,12 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
                     (std::isnan(x[k]) ? "nothing or nan" : "infinity"));
       }
     }
-    frame.position.row(row) = x.cwiseProduct(scale);
+    const Eigen::Vector3d scaled = x.cwiseProduct(scale);
+    if (!scaled.allFinite()) {
+      throw Error(at(csv, line) +
+                  ": position (x,y,z) times the voxel size is beyond a double's range");
+    }
+    frame.position.row(row) = scaled;
     if (has_axis) {
       const Eigen::Vector3d a(t["ax"].values[r], t["ay"].values[r], t["az"].values[r]);
       const int unknown = a.array().isNaN().count();

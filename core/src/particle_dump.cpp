@@ -1,8 +1,11 @@
 #include "granmem/core/particle_dump.hpp"
 
 #include <charconv>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
@@ -31,16 +34,29 @@ Box frame_box(const RunHeader& h, const Frame& f) {
   return Box{lo, hi - lo};
 }
 
+// LAMMPS numbers atoms from 1 (a granmem id + 1), up to its 32-bit tagint's largest.
+void check_lammps_ids(const std::vector<std::int64_t>& ids, const std::filesystem::path& out) {
+  for (std::int64_t id : ids) {
+    if (id < 0 || id >= std::int64_t(std::numeric_limits<std::int32_t>::max())) {
+      throw Error(out.string() + ": grain id " + std::to_string(id) +
+                  " has no LAMMPS atom id (LAMMPS ids are 1 to 2147483647, a granmem id + 1); "
+                  "use --format extxyz");
+    }
+  }
+}
+
 }  // namespace
 
 void write_particle_dump(const TrajectoryReader& run, const std::filesystem::path& out,
                          DumpFormat format) {
   const RunHeader& h = run.header();
+  const bool lammps = format == DumpFormat::lammps;
+  if (lammps) check_lammps_ids(h.id, out);
   AtomicFile file(out);
   std::ofstream s(file.temp_path(), std::ios::binary);
   if (!s) throw Error(out.string() + ": cannot open for writing");
 
-  std::string names = "id x y z radius";
+  std::string names = "id type x y z radius";
   std::string properties = "id:I:1:pos:R:3:radius:R:1";
   if (h.has_axis) {
     names += " ax ay az";
@@ -63,7 +79,7 @@ void write_particle_dump(const TrajectoryReader& run, const std::filesystem::pat
       seen += f.position.row(i).allFinite();
     const Box box = frame_box(h, f);
     const Eigen::Vector3d hi = box.lower + box.edges;
-    if (format == DumpFormat::lammps) {
+    if (lammps) {
       text += "ITEM: TIMESTEP\n" + std::to_string(f.step) + "\nITEM: NUMBER OF ATOMS\n" +
               std::to_string(seen) + "\nITEM: BOX BOUNDS ff ff ff\n";
       for (int k = 0; k < 3; ++k) {
@@ -91,7 +107,8 @@ void write_particle_dump(const TrajectoryReader& run, const std::filesystem::pat
     }
     for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
       if (!f.position.row(i).allFinite()) continue;
-      text += std::to_string(h.id[std::size_t(i)]);
+      const std::int64_t id = h.id[std::size_t(i)];
+      text += lammps ? std::to_string(id + 1) + " 1" : std::to_string(id);
       auto put = [&](double v) {
         text += ' ';
         number(text, v);

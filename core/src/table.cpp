@@ -4,8 +4,10 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
+#include <sstream>
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
@@ -62,12 +64,26 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-// Splits one CSV line on commas (granmem's tables have no quoted commas).
+// Splits one CSV line on commas; a field in double quotes (RFC 4180) may hold commas and
+// doubled quotes, and is given without its quotes.
 void split(std::string_view line, std::vector<std::string_view>& fields) {
   fields.clear();
   std::size_t start = 0;
   while (true) {
-    const std::size_t comma = line.find(',', start);
+    std::size_t text = line.find_first_not_of(" \t", start);
+    if (text != std::string_view::npos && line[text] == '"') {
+      for (++text; text < line.size(); ++text) {  // to the closing quote
+        if (line[text] != '"') continue;
+        if (text + 1 < line.size() && line[text + 1] == '"') {
+          ++text;
+        } else {
+          break;
+        }
+      }
+    } else {
+      text = start;
+    }
+    const std::size_t comma = line.find(',', std::min(text, line.size()));
     fields.push_back(trim(line.substr(start, comma - start)));
     if (comma == std::string_view::npos) return;
     start = comma + 1;
@@ -91,6 +107,12 @@ std::optional<double> parse_number(std::string_view field) {
 void write_csv(const Table& table, const std::filesystem::path& path,
                const std::vector<std::string>& comment) {
   AtomicFile file(path);  // a failed write leaves any earlier table in place
+  write_csv(table, file, comment);
+  file.commit();
+}
+
+void write_csv(const Table& table, AtomicFile& file, const std::vector<std::string>& comment) {
+  const std::filesystem::path& path = file.target();
   std::ofstream out(file.temp_path(), std::ios::binary);
   if (!out) throw Error(path.string() + ": cannot open for writing");
   std::string text;
@@ -114,14 +136,19 @@ void write_csv(const Table& table, const std::filesystem::path& path,
   out << text;
   out.close();
   if (!out) throw Error(path.string() + ": write failed (disk full?)");
-  file.commit();
 }
 
 CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::string>& required,
                     const std::vector<std::string>& optional) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open for reading");
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw Error(path.string() + ": cannot open for reading");
   const std::string where = path.string();
+  // Lines may end in LF, CRLF or a lone CR (classic Mac OS, some instrument software).
+  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  for (std::size_t k = 0; (k = text.find('\r', k)) != std::string::npos; ++k) {
+    if (k + 1 == text.size() || text[k + 1] != '\n') text[k] = '\n';
+  }
+  std::istringstream in(std::move(text));
 
   std::string line;
   std::size_t line_no = 0;

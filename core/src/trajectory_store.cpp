@@ -103,7 +103,7 @@ struct TrajectoryWriter::Impl {
   std::vector<double> times;
 
   Impl(const std::filesystem::path& path, RunHeader h)
-      : header(std::move(h)), out(path), file(h5::File::create(out.temp_path())) {}
+      : header(std::move(h)), out(path), file(h5::File::create(out)) {}
   Impl(RunHeader h, h5::File opened, AtomicFile temp)
       : header(std::move(h)), out(std::move(temp)), file(std::move(opened)) {}
 

@@ -186,7 +186,7 @@ std::vector<std::filesystem::path> write_motion_analysis(
     files.emplace_back(dir / name);
     std::vector<std::string> lines = comment;
     lines.push_back(what);
-    write_csv(table, files.back().temp_path(), lines);
+    write_csv(table, files.back(), lines);
   };
   const std::string units = "lengths in " + analysis.length_unit + ", angles in degrees";
   csv("displacements.csv", analysis.displacements,
@@ -202,7 +202,7 @@ std::vector<std::filesystem::path> write_motion_analysis(
 
   files.emplace_back(dir / "analysis.h5");
   {
-    h5::File f = h5::File::create(files.back().temp_path());
+    h5::File f = h5::File::create(files.back());
     h5::write_table(f.id(), "/displacements", analysis.displacements);
     h5::write_table(f.id(), "/per_frame", analysis.per_frame);
     for (const auto& [q, table] : analysis.pdfs) {

@@ -85,7 +85,7 @@ void write_checkpoint(const std::filesystem::path& path, const Simulation& sim,
                       const ProtocolState& protocol) {
   AtomicFile out(path);
   {
-    h5::File f = h5::File::create(out.temp_path());
+    h5::File f = h5::File::create(out);
     h5::Handle root = h5::create_group(f.id(), "/checkpoint");
     h5::write_attribute(root.get(), "format", kFormat);
     h5::write_attribute(root.get(), "creator", std::string("granmem ") + kVersion);

@@ -332,6 +332,63 @@ TEST_F(BadInputTest, AnalysisOutputIsNotARun) {
   expect_clean_failure({"export", "out/analysis.h5", "--out", "x.dump"}, expected);
 }
 
+// An output named like an input (by the same name, another path or a link) would destroy
+// the input: refused before any work, for every command that reads and writes files.
+TEST_F(BadInputTest, AnOutputThatIsAnInputIsRefused) {
+  make_good_outputs();
+  fs::create_symlink("good.csv", in_work("link.csv"));
+  const std::vector<std::vector<std::string>> commands = {
+      {"import", "good.csv", "--out", "good.csv", "--length-unit", "mm"},
+      {"import", "good.csv", "--out", "./link.csv", "--length-unit", "mm"},
+      {"export", "run.h5", "--out", "run.h5", "--format", "lammps"},
+      {"link", "run.h5", "--out", "run.h5"},
+      {"link", "run.h5", "x.dump", "--out", "new.h5", "--report", "x.dump"},
+      {"locate", "x.dump", "--out", "x.dump", "--diameter", "10"},
+      {"locate", "x.dump", "--out", "new.h5", "--csv", "x.dump", "--diameter", "10"},
+      {"track", "x.dump", "--out", "x.dump", "--diameter", "10"},
+      {"render", "run.h5", "--frame", "0", "--out", "run.h5"},
+      {"render", "run.h5", "--frame", "0", "--out", "scan.tif", "--truth", "run.h5"}};
+  for (const auto& args : commands)
+    expect_clean_failure(args, {"is the input", "choose another name"});
+  expect_clean_failure({"locate", "x.dump", "--out", "a.h5", "--csv", "./a.h5", "--diameter", "10"},
+                       {"are one file"});
+  expect_clean_failure({"track", "x.dump", "nothere.tif", "--out", "new.h5", "--diameter", "10"},
+                       {"nothere.tif", "no such file"});
+}
+
+// A full disk, made by a file size limit of 4 KiB (SIGXFSZ ignored, so a write past it
+// fails as with ENOSPC): one error line naming the output, exit 1, no crash, nothing left
+// behind and nothing changed (an existing run.h5 and analysis included).
+TEST_F(BadInputTest, AFullDiskIsOneErrorAndDamagesNothing) {
+  make_good_outputs();
+  const std::vector<std::vector<std::string>> commands = {
+      {"import", "good.csv", "--out", "run.h5", "--length-unit", "mm"},
+      {"analyze", "run.h5", "--out", "out"},
+      {"simulate", "--grains", "60", "--box", "2cm", "--cycles", "1", "--period", "20ms", "--out",
+       "run.h5"}};
+  for (const auto& args : commands) {
+    std::string cmd = "cd " + shell_quote(work().string()) + " && trap '' XFSZ && ulimit -f 4 && " +
+                      shell_quote(GRANMEM_EXE);
+    for (const std::string& a : args)
+      cmd += " " + shell_quote(a);
+    SCOPED_TRACE(cmd);
+    const auto before = snapshot(work());
+    const fs::path err = dir_ / "full.err";
+    const int status = std::system((cmd + " > /dev/null 2> " + shell_quote(err.string())).c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << "ended by a signal";
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+    // The error is the last line (simulate reports its deposit before).
+    const std::string text = read_text(err);
+    const std::size_t last = text.rfind('\n', text.size() - 2);
+    const std::string message = text.substr(last == std::string::npos ? 0 : last + 1);
+    EXPECT_EQ(message.find("granmem: error: "), 0u) << text;
+    EXPECT_EQ(text.find("granmem: error: "), text.rfind("granmem: error: ")) << text;
+    EXPECT_NE(message.find("(disk full?)"), std::string::npos) << message;
+    EXPECT_EQ(message.find(".tmp-"), std::string::npos) << "names a temporary: " << message;
+    EXPECT_EQ(snapshot(work()), before);
+  }
+}
+
 TEST_F(BadInputTest, MissingFile) {
   make_good_outputs();
   expect_clean_failure({"info", "nothere.h5"}, {"nothere.h5"});

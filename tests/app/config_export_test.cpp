@@ -195,25 +195,25 @@ TEST_F(GranmemTest, ExportLammpsDumpHasTheAtomsOfEachFrame) {
   EXPECT_EQ(r.out, "wrote run.dump (lammps, 3 frames)\n");
   // Without a container the box is the grains' bounding box; grain 20 is not in frame 1.
   // Axes are stored as unit vectors; grain 30's radius is unknown.
-  const std::string atoms = "ITEM: ATOMS id x y z radius ax ay az hole_contact\n";
+  const std::string atoms = "ITEM: ATOMS id type x y z radius ax ay az hole_contact\n";
   EXPECT_EQ(read_text(in_work("run.dump")),
             "ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS ff ff ff\n"
             "1 7\n2 8\n3 9\n" +
                 atoms +
-                "10 1 2 3 0.5 0 0 1 0\n"
-                "20 4 5 6 0.75 0 1 0 1\n"
-                "30 7 8 9 nan -1 0 0 0\n"
+                "11 1 1 2 3 0.5 0 0 1 0\n"
+                "21 1 4 5 6 0.75 0 1 0 1\n"
+                "31 1 7 8 9 nan -1 0 0 0\n"
                 "ITEM: TIMESTEP\n1\nITEM: NUMBER OF ATOMS\n2\nITEM: BOX BOUNDS ff ff ff\n"
                 "1.5 7\n2 8\n3 9.25\n" +
                 atoms +
-                "10 1.5 2 3 0.5 0 0 1 0\n"
-                "30 7 8 9.25 nan -1 0 0 0\n"
+                "11 1 1.5 2 3 0.5 0 0 1 0\n"
+                "31 1 7 8 9.25 nan -1 0 0 0\n"
                 "ITEM: TIMESTEP\n2\nITEM: NUMBER OF ATOMS\n3\nITEM: BOX BOUNDS ff ff ff\n"
                 "1.5 7\n2.5 8\n3 9.5\n" +
                 atoms +
-                "10 1.5 2.5 3 0.5 1 0 0 0\n"
-                "20 4 5 6.5 0.75 0 0 1 0\n"
-                "30 7 8 9.5 nan 0 -1 0 1\n");
+                "11 1 1.5 2.5 3 0.5 1 0 0 0\n"
+                "21 1 4 5 6.5 0.75 0 0 1 0\n"
+                "31 1 7 8 9.5 nan 0 -1 0 1\n");
 
   // With a container, every frame has its bounds; --format overrides the file name.
   granmem_ok(
@@ -226,6 +226,39 @@ TEST_F(GranmemTest, ExportLammpsDumpHasTheAtomsOfEachFrame) {
        ++at)
     ++bounds;
   EXPECT_EQ(bounds, 3u) << boxed;
+}
+
+// LAMMPS itself reads the dump: `read_dump` adds every grain of a frame with its id (the
+// granmem id + 1) and position, and writes them back.
+TEST_F(GranmemTest, ExportLammpsDumpIsReadByLammps) {
+#ifndef GRANMEM_LAMMPS_EXE
+  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
+#else
+  write_text(in_work("t.csv"), kExportTable);
+  granmem_ok(
+      {"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--box", "0,0,0,10,10,20"});
+  granmem_ok({"export", "boxed.h5", "--out", "run.dump"});
+  write_text(in_work("read.lmp"),
+             "units si\natom_style sphere\nboundary f f f\n"
+             "region box block 0 1 0 1 0 1\ncreate_box 1 box\n"
+             "read_dump run.dump 2 x y z add keep box yes\n"
+             "write_dump all custom back.dump id type x y z modify sort id format float %.17g\n");
+  const std::string cmd = "cd " + testing::shell_quote(work().string()) + " && " +
+                          testing::shell_quote(GRANMEM_LAMMPS_EXE) +
+                          " -in read.lmp -log none -screen none > lmp.out 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << read_text(in_work("lmp.out"));
+  std::istringstream back(read_text(in_work("back.dump")));
+  std::string line;
+  while (std::getline(back, line) && line.rfind("ITEM: ATOMS", 0) != 0) {
+  }
+  EXPECT_EQ(line, "ITEM: ATOMS id type x y z");
+  std::vector<std::vector<double> > atoms;
+  for (double id, type, x, y, z; back >> id >> type >> x >> y >> z;)
+    atoms.push_back({id, type, x, y, z});
+  // Frame 2 of the table: grains 10, 20 and 30.
+  EXPECT_EQ(atoms, (std::vector<std::vector<double> >{
+                       {11, 1, 1.5, 2.5, 3}, {21, 1, 4, 5, 6.5}, {31, 1, 7, 8, 9.5}}));
+#endif
 }
 
 TEST_F(GranmemTest, ExportExtendedXyz) {

@@ -1,6 +1,8 @@
 #include "granmem/core/atomic_file.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -110,6 +112,75 @@ TEST_F(AtomicFileTest, MissingFolderOrFolderTargetIsAnError) {
   }
   fs::create_directory(path("sub"));
   EXPECT_THROW(AtomicFile f(path("sub")), Error);
+  EXPECT_EQ(listing(), (std::vector<std::string>{"sub"}));
+}
+
+// A process that has ended: its id.
+pid_t ended_process() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  return child;
+}
+
+TEST_F(AtomicFileTest, TemporariesOfAKilledWriterAreRemovedByTheNext) {
+  const std::string dead = ".run.h5.tmp-" + std::to_string(ended_process()) + "-0";
+  const std::string live = ".run.h5.tmp-" + std::to_string(getpid()) + "-7";
+  const std::string other = ".other.h5.tmp-" + std::to_string(ended_process()) + "-0";
+  for (const std::string& name : {dead, live, other, std::string("run.h5")})
+    write_text(path(name), "x");
+  {
+    AtomicFile f(path("run.h5"));
+    write_text(f.temp_path(), "new");
+    f.commit();
+  }
+  // The killed writer's temporary of run.h5 is gone; a running writer's, another target's
+  // and the target itself are not touched but by the commit.
+  std::vector<std::string> expected{live, other, "run.h5"};
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(listing(), expected);
+  EXPECT_EQ(read_text(path("run.h5")), "new");
+}
+
+// The message of check_outputs, or "" when it accepts.
+std::string refusal(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
+  try {
+    check_outputs(outputs, inputs);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+TEST_F(AtomicFileTest, AnOutputThatIsAnInputByAnyNameIsRefused) {
+  write_text(path("t.csv"), "x,y,z\n");
+  fs::create_directory(path("sub"));
+  fs::create_symlink(path("t.csv"), path("link.csv"));
+  fs::create_hard_link(path("t.csv"), path("sub") / "hard.csv");
+  const std::vector<NamedPath> in{{"table", path("t.csv")}};
+  for (const fs::path& out :
+       {path("t.csv"), path("sub") / ".." / "t.csv", path("link.csv"), path("sub") / "hard.csv"}) {
+    const std::string why = refusal({{"--out", out}}, in);
+    EXPECT_NE(why.find("is the input table"), std::string::npos) << out << ": " << why;
+  }
+  // Relative and absolute names of one file, the output not there yet.
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir_);
+  EXPECT_NE(refusal({{"--out", "new.h5"}}, {{"run", dir_ / "new.h5"}}), "");
+  EXPECT_EQ(refusal({{"--out", "other.h5"}}, {{"run", dir_ / "new.h5"}}), "");
+  fs::current_path(cwd);
+  EXPECT_EQ(read_text(path("t.csv")), "x,y,z\n");
+}
+
+TEST_F(AtomicFileTest, TwoOutputsThatAreOneFileOrAMissingFolderAreRefused) {
+  fs::create_directory(path("sub"));
+  const std::string twice = refusal({{"--out", path("a.h5")}, {"--csv", path("sub/../a.h5")}}, {});
+  EXPECT_NE(twice.find("are one file"), std::string::npos) << twice;
+  const std::string missing = refusal({{"--out", path("missing") / "a.h5"}}, {});
+  EXPECT_NE(missing.find("does not exist"), std::string::npos) << missing;
+  EXPECT_EQ(
+      refusal({{"--out", path("a.h5")}, {"--csv", path("a.csv")}}, {{"table", path("t.csv")}}), "");
   EXPECT_EQ(listing(), (std::vector<std::string>{"sub"}));
 }
 

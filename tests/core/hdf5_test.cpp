@@ -1,9 +1,14 @@
 #include "granmem/core/hdf5.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -88,6 +93,38 @@ TEST_F(Hdf5, FramesGrowOneAtATime) {
   EXPECT_NE(msg.find(p.string() + ": /g/value has no frame 3"), std::string::npos) << msg;
   EXPECT_EQ(h5::read_string_attribute(set.get(), "unit"), std::string("cm"));
   EXPECT_EQ(h5::read_string_attribute(set.get(), "absent"), std::nullopt);
+}
+
+// A full disk, made by a file size limit (writes past 64 KiB fail, as with ENOSPC): closing
+// the file must say so in one Error, and the process must end normally. A failed close
+// once went on to close the file again, and HDF5's exit handler closed it once more: both
+// crashed. In a child process, whose exit is the point.
+TEST_F(Hdf5, AFullDiskIsOneErrorAtCloseAndNoCrash) {
+  const std::string file = path("full.h5").string();
+  const pid_t child = fork();
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);  // the write fails with EFBIG instead
+    const rlimit limit{64 << 10, 64 << 10};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    try {
+      h5::File f = h5::File::create(file);
+      {
+        h5::Handle set = h5::create_frames<double>(f.id(), "/g/value", {1000, 3}, "cm");
+        std::vector<double> frame(3000, 1.0);
+        for (int t = 0; t < 20; ++t)
+          h5::append_frame(set.get(), frame.data());
+      }
+      f.close();
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      std::exit(msg.find(file + ": writing the HDF5 file failed") == 0 ? 3 : 4);
+    }
+    std::exit(5);  // no error: the full disk went unnoticed
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "the child ended by signal " << WTERMSIG(status);
+  EXPECT_EQ(WEXITSTATUS(status), 3);
 }
 
 TEST_F(Hdf5, MissingObjectsNameFileAndPath) {

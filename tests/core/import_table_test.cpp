@@ -206,6 +206,27 @@ TEST_F(ImportTable, RadiusOptionIsTheFallbackForTablesWithoutRadius) {
   EXPECT_NE(msg.find("--radius"), std::string::npos) << msg;
 }
 
+// 2,000 rows, each a new frame and a new particle: a dense store of 4e6 slots, 0.05 %
+// filled, refused before it is made; a coordinate that overflows when scaled to voxels too.
+TEST_F(ImportTable, LabelsThatNeverRepeatAndOverflowingCoordinatesAreRefused) {
+  std::string csv = "frame,particle,x,y,z\n";
+  for (int r = 0; r < 2000; ++r)
+    csv += std::to_string(r) + "," + std::to_string(r) + ",1,2,3\n";
+  expect_error(csv, "2000 rows label 2000 frames x 2000 particles, of which 0.05 %");
+  // As many slots, but every particle in every frame: accepted.
+  std::string dense = "frame,particle,x,y,z\n";
+  for (int t = 0; t < 2; ++t)
+    for (int p = 0; p < 1000; ++p)
+      dense += std::to_string(t) + "," + std::to_string(p) + ",1,2,3\n";
+  write_text(path("dense.csv"), dense);
+  EXPECT_EQ(import_table(path("dense.csv"), ImportOptions{}).frames.size(), 2u);
+  ImportOptions voxels;
+  voxels.length_unit = "voxel";
+  voxels.voxel_size = Eigen::Vector3d(10, 10, 10);
+  voxels.voxel_size_unit = "um";
+  expect_error("frame,particle,x,y,z\n0,1,1e308,2,3\n", "beyond a double's range", voxels);
+}
+
 TEST_F(ImportTable, MissingRequiredColumnIsNamed) {
   expect_error("frame,particle,x,y\n0,1,1,2\n", "'z'");
   expect_error("frame,x,y,z\n0,1,1,2\n", "'particle'");

@@ -70,9 +70,9 @@ TEST_F(ParticleDump, LammpsDumpIsExact) {
       "-1 1\n"
       "0 3\n"
       "0.5 4.5\n"
-      "ITEM: ATOMS id x y z radius ax ay az hole_contact\n"
-      "10 0.5 1 1.5 0.5 0 0 1 1\n"
-      "20 1.25 2 3.5 0.25 1 0 0 0\n"
+      "ITEM: ATOMS id type x y z radius ax ay az hole_contact\n"
+      "11 1 0.5 1 1.5 0.5 0 0 1 1\n"
+      "21 1 1.25 2 3.5 0.25 1 0 0 0\n"
       "ITEM: TIMESTEP\n"
       "2\n"
       "ITEM: NUMBER OF ATOMS\n"
@@ -81,8 +81,8 @@ TEST_F(ParticleDump, LammpsDumpIsExact) {
       "-1 1\n"
       "0 3\n"
       "0.5 4.5\n"
-      "ITEM: ATOMS id x y z radius ax ay az hole_contact\n"
-      "20 1.5 -2.25 3 0.25 0 1 0 1\n";
+      "ITEM: ATOMS id type x y z radius ax ay az hole_contact\n"
+      "21 1 1.5 -2.25 3 0.25 0 1 0 1\n";
   EXPECT_EQ(read_text(out), expected);
 }
 
@@ -99,9 +99,9 @@ TEST_F(ParticleDump, LammpsDumpWithOrientationAndNoBoxUsesTheBoundingBox) {
       "0.5 1.25\n"
       "1 2\n"
       "1.5 3.5\n"
-      "ITEM: ATOMS id x y z radius ax ay az quatw quati quatj quatk hole_contact\n"
-      "10 0.5 1 1.5 0.5 0 0 1 1 0 0 0 1\n"
-      "20 1.25 2 3.5 0.25 1 0 0 0 0 0 1 0\n"
+      "ITEM: ATOMS id type x y z radius ax ay az quatw quati quatj quatk hole_contact\n"
+      "11 1 0.5 1 1.5 0.5 0 0 1 1 0 0 0 1\n"
+      "21 1 1.25 2 3.5 0.25 1 0 0 0 0 0 1 0\n"
       "ITEM: TIMESTEP\n"
       "2\n"
       "ITEM: NUMBER OF ATOMS\n"
@@ -110,8 +110,8 @@ TEST_F(ParticleDump, LammpsDumpWithOrientationAndNoBoxUsesTheBoundingBox) {
       "1.5 1.5\n"
       "-2.25 -2.25\n"
       "3 3\n"
-      "ITEM: ATOMS id x y z radius ax ay az quatw quati quatj quatk hole_contact\n"
-      "20 1.5 -2.25 3 0.25 0 1 0 0.5 -0.5 0.5 -0.5 1\n";
+      "ITEM: ATOMS id type x y z radius ax ay az quatw quati quatj quatk hole_contact\n"
+      "21 1 1.5 -2.25 3 0.25 0 1 0 0.5 -0.5 0.5 -0.5 1\n";
   EXPECT_EQ(read_text(out), expected);
 }
 

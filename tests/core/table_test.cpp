@@ -146,6 +146,17 @@ TEST_F(TableCsv, CommentsBlankLinesAndUnrequestedColumnsAreSkipped) {
   EXPECT_EQ(c.lines, (std::vector<std::size_t>{4, 6, 8, 9}));
 }
 
+// Lines ending in a lone CR (classic Mac OS, some instruments' software) and quoted fields
+// holding commas and quotes (RFC 4180, as spreadsheets write text).
+TEST_F(TableCsv, LoneCarriageReturnsAndQuotedCommasAreRead) {
+  const auto file = path("mac.csv");
+  write_text(file, "frame,name,x\r0,\"grain, \"\"big\"\"\",1.5\r1,plain,2.5\r\r2,\"\",3.5");
+  const CsvColumns c = read_csv(file, {"frame", "x"});
+  EXPECT_EQ(c.table["frame"].values, (std::vector<double>{0, 1, 2}));
+  EXPECT_EQ(c.table["x"].values, (std::vector<double>{1.5, 2.5, 3.5}));
+  EXPECT_EQ(c.lines, (std::vector<std::size_t>{2, 3, 5}));
+}
+
 TEST_F(TableCsv, ExcelByteOrderMarkIsSkipped) {
   // Excel's "CSV UTF-8" starts the file with EF BB BF, before the header or a comment.
   const auto file = path("excel.csv");

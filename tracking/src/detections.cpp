@@ -109,9 +109,9 @@ void write_detections(const Detections& d, const std::filesystem::path& path) {
                         std::to_string((*d.voxel_size)[1]) + "," +
                         std::to_string((*d.voxel_size)[2]) + " " + d.length_unit);
     }
-    write_csv(t, out.temp_path(), comment);
+    write_csv(t, out, comment);
   } else {
-    h5::File f = h5::File::create(out.temp_path());
+    h5::File f = h5::File::create(out);
     h5::write_table(f.id(), "/detections", t);
     h5::Handle g = h5::open_group(f, "/detections");
     h5::write_attribute(g.get(), "length_unit", d.length_unit);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/table.hpp"
 
 // A thin layer over the HDF5 C library: owned identifiers, whole-dataset and per-frame
@@ -27,6 +28,7 @@ class Handle {
 
   hid_t get() const { return id_; }
   void reset();
+  hid_t release();  // the id, no longer closed by this handle
 
  private:
   hid_t id_ = -1;
@@ -36,8 +38,9 @@ class Handle {
 // An open file and its name, which every message about it carries.
 class File {
  public:
-  static File create(const std::filesystem::path& path);            // new file, truncating
-  static File open(const std::filesystem::path& path);              // read-only; Error if not HDF5
+  static File create(const std::filesystem::path& path);  // new file, truncating
+  static File create(const AtomicFile& file);             // its temporary, named by its target
+  static File open(const std::filesystem::path& path);    // read-only; Error if not HDF5
   static File open_for_writing(const std::filesystem::path& path);  // an existing file
   void flush();  // everything written so far on disk: the file is complete as it stands
   hid_t id() const { return handle_.get(); }
@@ -45,6 +48,7 @@ class File {
   void close();  // flushes; throws Error if the data could not be written
 
  private:
+  static File create(const std::filesystem::path& path, const std::string& name);
   Handle handle_;
   std::string name_;
 };

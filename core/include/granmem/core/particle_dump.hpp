@@ -8,7 +8,10 @@ namespace granmem {
 
 // Text formats OVITO (and ASE, VMD) read; OVITO cannot read H5MD.
 enum class DumpFormat {
-  lammps,  // LAMMPS text dump: id x y z radius [ax ay az] [quatw quati quatj quatk] [hole_contact]
+  // LAMMPS text dump, as `read_dump` and OVITO read it: id type x y z radius [ax ay az]
+  // [quatw quati quatj quatk] [hole_contact], where id is the granmem id + 1 (LAMMPS
+  // numbers atoms from 1) and type is 1.
+  lammps,
   extxyz,  // extended XYZ with the same per-grain properties
 };
 

@@ -7,6 +7,8 @@
 #include <string_view>
 #include <vector>
 
+#include "granmem/core/atomic_file.hpp"
+
 namespace granmem {
 
 // One named column of a long-form table. Integer columns (frame, particle, counts) are
@@ -39,6 +41,9 @@ class Table {
 // Numbers use the shortest text that reads back to the same double; NaN is "nan".
 void write_csv(const Table& table, const std::filesystem::path& path,
                const std::vector<std::string>& comment = {});
+// The same into `file`'s temporary, for outputs committed together; messages name its
+// target.
+void write_csv(const Table& table, AtomicFile& file, const std::vector<std::string>& comment = {});
 
 // A numeric CSV read for some of its columns, with the file line of each row for messages.
 struct CsvColumns {

@@ -1,0 +1,141 @@
+// A run stopped from outside: killed outright (kill -9, the machine's OOM killer, a node
+// lost), or asked to stop (SIGTERM from Slurm or a container stop, SIGINT from Ctrl-C).
+// What it wrote before stays whole and consistent, --resume finishes it with the same
+// result, bit for bit, as a run never stopped, and nothing temporary is left behind.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "granmem/core/trajectory_store.hpp"
+#include "run_granmem.hpp"
+
+namespace granmem {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::GranmemTest;
+using testing::RunResult;
+
+// 60 grains, cycles of 80,000 steps (about a second each): long enough to be stopped in.
+std::vector<std::string> slow_run(const std::string& out) {
+  return {"simulate", "--grains", "60", "--box",    "2cm",   "--amplitude",
+          "1%",       "--period", "2s", "--cycles", "3",     "--checkpoint-every",
+          "1",        "--out",    out,  "--track",  "0,5,9", "--samples-per-cycle",
+          "4"};
+}
+
+class Interruption : public GranmemTest {
+ protected:
+  // Starts granmem in the working folder, stdout and stderr to files in the capture folder.
+  pid_t start(const std::vector<std::string>& args) {
+    fs::create_directories(dir_ / "capture");
+    const std::string err = (dir_ / "capture" / "started.err").string();
+    const pid_t child = fork();
+    if (child == 0) {
+      if (chdir(work().c_str()) != 0) _exit(127);
+      const int fd = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      dup2(fd, 2);
+      const int null = open("/dev/null", O_WRONLY);
+      dup2(null, 1);
+      std::vector<char*> argv{const_cast<char*>(GRANMEM_EXE)};
+      for (const std::string& a : args)
+        argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      execv(GRANMEM_EXE, argv.data());
+      _exit(127);
+    }
+    return child;
+  }
+
+  // Waits until `name` appears in the working folder (or the child ends: false).
+  bool wait_for(pid_t child, const std::string& name) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+    while (!fs::exists(in_work(name))) {
+      int status = 0;
+      if (waitpid(child, &status, WNOHANG) == child) return false;
+      if (std::chrono::steady_clock::now() > give_up) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+  }
+
+  // The exit status, 128 + n when ended by signal n.
+  static int wait_exit(pid_t child) {
+    int status = 0;
+    waitpid(child, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+
+  std::vector<std::string> temporaries() const {
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(work())) {
+      const std::string name = e.path().filename().string();
+      if (name.find(".tmp-") != std::string::npos) left.push_back(name);
+    }
+    return left;
+  }
+};
+
+// The two stores hold the same frames, bit for bit.
+void expect_same_frames(const fs::path& a_path, const fs::path& b_path) {
+  SCOPED_TRACE(a_path.filename().string() + " vs " + b_path.filename().string());
+  const Trajectories a = read_trajectories(a_path), b = read_trajectories(b_path);
+  ASSERT_EQ(a.frames.size(), b.frames.size());
+  for (std::size_t t = 0; t < a.frames.size(); ++t) {
+    const Frame &fa = a.frames[t], &fb = b.frames[t];
+    EXPECT_EQ(fa.step, fb.step);
+    ASSERT_EQ(fa.position.size(), fb.position.size());
+    EXPECT_EQ(std::memcmp(fa.position.data(), fb.position.data(),
+                          fa.position.size() * sizeof(fa.position[0])),
+              0)
+        << "positions of frame " << t;
+    ASSERT_EQ(fa.orientation.size(), fb.orientation.size());
+    EXPECT_EQ(std::memcmp(fa.orientation.data(), fb.orientation.data(),
+                          fa.orientation.size() * sizeof(fa.orientation[0])),
+              0)
+        << "orientations of frame " << t;
+  }
+}
+
+TEST_F(Interruption, KilledOrStoppedRunsResumeToTheSameResultBitForBit) {
+  granmem_ok(slow_run("whole.h5"));
+  struct Case {
+    int signal;
+    std::string out;
+  };
+  for (const Case& c :
+       {Case{SIGKILL, "killed.h5"}, Case{SIGTERM, "termed.h5"}, Case{SIGINT, "interrupted.h5"}}) {
+    SCOPED_TRACE(strsignal(c.signal));
+    const std::string stem = fs::path(c.out).stem().string();
+    const std::string checkpoint = stem + ".checkpoint.h5";
+    const pid_t child = start(slow_run(c.out));
+    ASSERT_TRUE(wait_for(child, checkpoint)) << "no checkpoint after the first cycle";
+    kill(child, c.signal);
+    const int status = wait_exit(child);
+    EXPECT_EQ(status, 128 + c.signal);
+    if (c.signal != SIGKILL) {
+      const std::string err = testing::read_file(dir_ / "capture" / "started.err");
+      EXPECT_NE(err.find("stopped after cycle"), std::string::npos) << err;
+      EXPECT_TRUE(temporaries().empty()) << temporaries().front();
+    }
+    // What was published is whole: the store, its sidecar and the checkpoint read.
+    EXPECT_GE(TrajectoryReader(in_work(c.out)).frame_count(), 2u);
+    EXPECT_TRUE(fs::exists(in_work(stem + ".xmf")));
+    granmem_ok({"simulate", "--resume", checkpoint, "--cycles", "3"});
+    EXPECT_TRUE(temporaries().empty()) << temporaries().front();
+    expect_same_frames(in_work("whole.h5"), in_work(c.out));
+    expect_same_frames(in_work("whole_in_cycle.h5"), in_work(stem + "_in_cycle.h5"));
+  }
+}
+
+}  // namespace
+}  // namespace granmem

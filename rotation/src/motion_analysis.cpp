@@ -66,6 +66,9 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   Column& p_drift_y = p.add("drift_y", L);
   Column& p_drift_z = p.add("drift_z", L);
   Column& p_prev = p.add("prev_frame", "", true);
+  // The structure of frame f (not a change from f-1): from positions, as in a scan.
+  Column& p_packing = p.add("packing_fraction", "");
+  Column& p_coordination = p.add("coordination", "");
 
   Frame before = run.read_frame(0);
   for (std::size_t t = 1; t < run.frame_count(); ++t) {
@@ -114,6 +117,10 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     p_drift_y.values.push_back(m.drift.y());
     p_drift_z.values.push_back(m.drift.z());
     p_prev.values.push_back(double(before.step));
+    const PackingStructure structure =
+        packing_structure(after.position, h.radius, options.structure);
+    p_packing.values.push_back(structure.packing_fraction);
+    p_coordination.values.push_back(structure.coordination);
     before = std::move(after);
   }
 

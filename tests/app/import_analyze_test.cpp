@@ -50,7 +50,9 @@ const std::vector<std::string> kPerFrameColumns = {"frame",
                                                    "drift_x",
                                                    "drift_y",
                                                    "drift_z",
-                                                   "prev_frame"};
+                                                   "prev_frame",
+                                                   "packing_fraction",
+                                                   "coordination"};
 
 std::string join(const std::vector<std::string>& names) {
   std::string s;

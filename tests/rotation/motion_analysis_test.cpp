@@ -163,10 +163,11 @@ TEST_F(MotionAnalysisTest, PerFrameStatisticsOfEachFramePair) {
   const MotionAnalysis a = analyze_motion(stored(three_grain_run()), {});
   const Table& p = a.per_frame;
   ASSERT_EQ(column_names(p),
-            (std::vector<std::string>{
-                "frame", "n", "mean_dr", "median_dr", "mean_theta_axis_deg", "mean_rot_disp",
-                "median_theta_axis_deg", "median_rot_disp", "n_rot", "msd", "mean_theta_full_deg",
-                "median_theta_full_deg", "drift_x", "drift_y", "drift_z", "prev_frame"}));
+            (std::vector<std::string>{"frame", "n", "mean_dr", "median_dr", "mean_theta_axis_deg",
+                                      "mean_rot_disp", "median_theta_axis_deg", "median_rot_disp",
+                                      "n_rot", "msd", "mean_theta_full_deg",
+                                      "median_theta_full_deg", "drift_x", "drift_y", "drift_z",
+                                      "prev_frame", "packing_fraction", "coordination"}));
   EXPECT_EQ(p["msd"].unit, "mm^2");
   EXPECT_EQ(p["frame"].values, (std::vector<double>{105, 107}));
   EXPECT_EQ(p["prev_frame"].values, (std::vector<double>{100, 105}));

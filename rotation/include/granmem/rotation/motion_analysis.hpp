@@ -12,6 +12,7 @@
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/rotation/grain_motion.hpp"
+#include "granmem/rotation/packing_structure.hpp"
 
 namespace granmem {
 
@@ -23,6 +24,7 @@ struct AnalysisOptions {
   // Frames (labels, inclusive) pooled into the pdfs; default all.
   std::optional<std::pair<std::int64_t, std::int64_t>> pdf_frames;
   DensityOptions density;
+  StructureOptions structure;  // the per-frame packing fraction and coordination
 };
 
 // The paper's statistics of a run between consecutive frames f-1 -> f.
@@ -33,7 +35,8 @@ struct MotionAnalysis {
   Table displacements;
   // One row per frame f >= 1: frame, n, mean_dr, median_dr, mean_theta_axis_deg,
   // mean_rot_disp, median_theta_axis_deg, median_rot_disp, n_rot, msd, (mean and median
-  // theta_full_deg,) drift_x, drift_y, drift_z, prev_frame.
+  // theta_full_deg,) drift_x, drift_y, drift_z, prev_frame, packing_fraction and
+  // coordination of frame f (packing_structure.hpp; from positions and radii).
   Table per_frame;
   std::map<std::string, Table> pdfs;  // quantity -> bin_lo, bin_hi, bin_center, count, density
   std::string length_unit;

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <cstddef>
+#include <limits>
+#include <optional>
+#include <vector>
+
+#include "granmem/core/trajectories.hpp"
+
+namespace granmem {
+
+// The packing's structure from its grains' positions and radii alone, so that a scan and
+// a simulation are measured alike (a simulation's lid height and box are not in a scan).
+struct StructureOptions {
+  // The region measured: by default the box of the grain centres' extent, shrunk by
+  // `margin` median diameters on every side (away from the walls, floor and lid, where
+  // the packing is layered).
+  double margin = 2;
+  std::optional<Box> region;
+  // Two grains touch when their centres are closer than the sum of their radii times
+  // 1 + contact_gap (located positions carry an error; simulated grains overlap a little).
+  double contact_gap = 0.02;
+};
+
+struct PackingStructure {
+  // Solid volume inside the region (each sphere's part in it) over the region's volume.
+  double packing_fraction = std::numeric_limits<double>::quiet_NaN();
+  // Mean number of touching neighbours of the grains whose centres are in the region.
+  double coordination = std::numeric_limits<double>::quiet_NaN();
+  std::size_t grains = 0;  // centres in the region
+  Box region;
+};
+
+// Grains without a finite position are left out; a radius that is not known (NaN) is taken
+// as the median of the known ones. NaN results when the region is empty or no radius is
+// known.
+PackingStructure packing_structure(const Vectors3& position, const std::vector<double>& radius,
+                                   const StructureOptions& options = {});
+
+}  // namespace granmem

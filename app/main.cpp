@@ -1,11 +1,36 @@
 #include <exception>
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "git_commit.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/version.hpp"
 #include "simulation_settings.hpp"
+
+namespace {
+
+// CLI11 says "INI was not able to parse X" for every config line it could not use: a
+// section header without its ']', a line without '=', or an option no command has.
+std::string config_error(const std::string& what) {
+  const std::string prefix = "INI was not able to parse ";
+  if (what.rfind(prefix, 0) != 0) return what;
+  std::string line = what.substr(prefix.size());
+  if (!line.empty() && line.front() == '[') {
+    return "--config: '" + line + "' is not a [command] header (no closing ']')";
+  }
+  const std::size_t space = line.find(' ');
+  if (space != std::string::npos) {
+    const std::size_t dot = line.rfind('.', space);  // CLI11 writes section.key
+    const std::string section = dot == std::string::npos ? "" : line.substr(0, dot);
+    const std::string text = line.substr(dot == std::string::npos ? 0 : dot + 1);
+    return "--config: '" + text + "'" + (section.empty() ? "" : " in [" + section + "]") +
+           " is not 'option = value'";
+  }
+  return "--config: no option " + line + " ([command] option)";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"granmem: tracked grains and DEM runs of cyclically compressed packings"};
@@ -16,12 +41,7 @@ int main(int argc, char** argv) {
   app.fallthrough();                                        // --config may follow the command name
   app.allow_config_extras(CLI::config_extras_mode::error);  // a mistyped key is an error
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
-    std::string what = e.what();
-    const std::string unknown_key = "INI was not able to parse ";  // CLI11's words for a typo
-    if (what.rfind(unknown_key, 0) == 0) {
-      what = "--config: no option " + what.substr(unknown_key.size()) + " ([command] option)";
-    }
-    return "granmem: error: " + what + " (see granmem --help)\n";
+    return "granmem: error: " + config_error(e.what()) + " (see granmem --help)\n";
   });
   granmem::app::add_import(app);
   granmem::app::add_info(app);

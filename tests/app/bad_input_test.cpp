@@ -456,6 +456,16 @@ TEST_F(BadInputTest, CommandLineErrors) {
                        {"--pdf-bins: expected a whole number of bins, at least 1, got '-2'"});
   expect_clean_failure({"--config", "import.toml", "import", "good.csv", "--out", "run.h5"},
                        {"--length-unit: ft not in {m,cm,mm,um,voxel}"});
+  // A config that is not TOML, or names no option, says which line and why.
+  write_text(in_work("header.toml"), "[info\n");
+  write_text(in_work("equals.toml"), "[info]\nverbose 1\n");
+  write_text(in_work("typo.toml"), "[info]\nverbsoe = 1\n");
+  expect_clean_failure({"--config", "header.toml", "info", "run.h5"},
+                       {"--config: '[info' is not a [command] header (no closing ']')"});
+  expect_clean_failure({"--config", "equals.toml", "info", "run.h5"},
+                       {"--config: 'verbose 1' in [info] is not 'option = value'"});
+  expect_clean_failure({"--config", "typo.toml", "info", "run.h5"},
+                       {"--config: no option info.verbsoe"});
 }
 
 }  // namespace

@@ -180,6 +180,24 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   return a;
 }
 
+namespace {
+
+// The pdf tables an earlier analysis left in `dir` that this one did not write (another run,
+// other --pdf quantities): left there they would read as part of this one.
+void remove_stale_pdfs(const std::filesystem::path& dir,
+                       const std::vector<std::filesystem::path>& written) {
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    const bool pdf = name.rfind("pdf_", 0) == 0 && e.path().extension() == ".csv";
+    if (pdf && std::find(written.begin(), written.end(), dir / name) == written.end()) {
+      std::filesystem::remove(e.path(), ec);
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> write_motion_analysis(
     const MotionAnalysis& analysis, const std::filesystem::path& dir,
     const std::vector<std::string>& comment, const std::map<std::string, std::string>& parameters) {
@@ -228,6 +246,7 @@ std::vector<std::filesystem::path> write_motion_analysis(
     file.commit();
     written.push_back(file.target());
   }
+  remove_stale_pdfs(dir, written);
   return written;
 }
 

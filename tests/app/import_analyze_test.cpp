@@ -182,6 +182,16 @@ TEST_F(ImportAnalyzeTest, WritesPdfsAndTheSameTablesToAnalysisH5) {
   }
   EXPECT_EQ(read_columns(in_work("out") / "pdf_dr.csv", {"bin_lo"})["bin_lo"].values.front(), 0);
 
+  // A second analysis into the folder with other pdfs leaves none of the first's behind.
+  write_text(in_work("out") / "notes.txt", "mine");
+  granmem_ok({"analyze", "run.h5", "--out", "out", "--pdf", "dz"});
+  names.clear();
+  for (const auto& e : fs::directory_iterator(in_work("out")))
+    names.insert(e.path().filename().string());
+  EXPECT_EQ(names, (std::set<std::string>{"analysis.h5", "displacements.csv", "per_frame.csv",
+                                          "pdf_dz.csv", "notes.txt"}));
+  granmem_ok({"analyze", "run.h5", "--out", "out"});
+
   // analysis.h5 holds the same tables, with units.
   const h5::File f = h5::File::open(in_work("out") / "analysis.h5");
   const Table d = h5::read_table(f, "/displacements");

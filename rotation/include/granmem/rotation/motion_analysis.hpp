@@ -49,7 +49,8 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
 // Writes DIR/displacements.csv, DIR/per_frame.csv, DIR/pdf_<quantity>.csv and
 // DIR/analysis.h5 (the same tables, with units and `parameters` under /parameters/analyze).
 // Every file is written in full under a temporary name first and renamed into place only
-// when all are written. Returns the paths written.
+// when all are written; pdf_*.csv tables of an earlier analysis in DIR that this one does
+// not write are then removed. Returns the paths written.
 std::vector<std::filesystem::path> write_motion_analysis(
     const MotionAnalysis& analysis, const std::filesystem::path& dir,
     const std::vector<std::string>& comment, const std::map<std::string, std::string>& parameters);

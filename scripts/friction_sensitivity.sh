@@ -109,3 +109,28 @@ sort -t, -k1,1g -k2,2n <(grep -v '^#' "$per_run" | tail -n +2) | awk -F, '
     }
   }' >> "$sens"
 column -s, -t < "$sens" | sed -n '2,$p'
+
+# The figure: each observable against mu_s, both seeds.
+command -v gnuplot > /dev/null || { echo "friction_sensitivity.sh: gnuplot not found, no figure" >&2; exit 0; }
+grep -v '^#' "$per_run" | tail -n +2 | sort -t, -k2,2n -k1,1g |
+  awk -F, 'NR > 1 && $2 != seed { print "\n" } { seed = $2; print }' > "$out/per_run.dat"
+gnuplot <<GNUPLOT
+set terminal pngcairo size 1500,900 font "sans,11"
+set output "$out/sensitivity.png"
+set datafile separator ","
+set multiplot layout 2,3 title "Steady state (cycles $window) against sliding friction: 1,500 grains, 5 cm box, 436 Pa, A = 1 %, two packings"
+set logscale x
+set xrange [0.04:0.6]
+set xlabel "mu_s"
+set xtics ("0.05" 0.05, "0.1" 0.1, "0.2" 0.2, "0.3" 0.3, "0.5" 0.5)
+titles = "dr/d rot/d phi\\\\_pos z phi\\\\_lid force/N"
+labels = "'end-of-cycle displacement / d' 'rotational displacement / d' 'bulk packing fraction (positions)' 'coordination (gap 2 %)' 'packing fraction (lid height)' 'wall force at full compression, N'"
+do for [k = 3:8] {
+  set ylabel word(labels, k - 2)
+  if (k == 5 || k == 6 || k == 7) { set key top right } else { set key top left }
+  plot "$out/per_run.dat" index 0 using 1:k with linespoints pt 7 lc rgb "#440154" title "seed 1", \
+       "" index 1 using 1:k with linespoints pt 5 lc rgb "#21918c" title "seed 2"
+}
+unset multiplot
+GNUPLOT
+echo "wrote $per_run, $sens and $out/sensitivity.png"

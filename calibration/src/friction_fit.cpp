@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 
+#include "ceres_variance.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/random.hpp"
 #include "granmem/core/statistics.hpp"
@@ -207,16 +208,6 @@ struct SummaryResidual {
   }
 };
 
-// The 97.5 % point of Student's t with `dof` degrees of freedom (Cornish-Fisher expansion
-// about the normal's 1.96; within 0.2 % for dof >= 3): the interval's multiplier when the
-// realization noise is itself estimated from a few spare runs.
-double t_975(double dof) {
-  const double z = 1.959964, z3 = z * z * z, z5 = z3 * z * z;
-  if (!(dof > 0) || !std::isfinite(dof)) return z;
-  return z + (z3 + z) / (4 * dof) + (5 * z5 + 16 * z3 + 3 * z) / (96 * dof * dof) +
-         (3 * z5 * z * z + 19 * z5 + 17 * z3 - 15 * z) / (384 * dof * dof * dof);
-}
-
 std::string format_number(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", x);
@@ -381,17 +372,10 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
     fit.chi2 = 2 * summary.final_cost;
 
     if (round == 1) {
-      ceres::Covariance::Options co;
-      co.algorithm_type = ceres::DENSE_SVD;
-      co.null_space_rank = -1;
-      ceres::Covariance covariance(co);
-      std::vector<std::pair<const double*, const double*>> blocks{{&log_mu, &log_mu}};
-      if (fit_noise) blocks.push_back({&sigma, &sigma});
-      double var_mu = std::nan(""), var_sigma = std::nan("");
-      if (covariance.Compute(blocks, &problem)) {
-        covariance.GetCovarianceBlock(&log_mu, &log_mu, &var_mu);
-        if (fit_noise) covariance.GetCovarianceBlock(&sigma, &sigma, &var_sigma);
-      }
+      std::vector<double*> parameters{&log_mu};
+      if (fit_noise) parameters.push_back(&sigma);
+      const std::vector<double> variance = parameter_variances(problem, parameters);
+      const double var_mu = variance[0], var_sigma = fit_noise ? variance[1] : std::nan("");
       fit.dof = double(nj) - (fit_noise ? 2.0 : 1.0);
       fit.error_scale = fit.dof > 0 ? std::max(1.0, std::sqrt(fit.chi2 / fit.dof)) : 1.0;
       fit.log_mu_s_sigma = std::sqrt(var_mu) * fit.error_scale;
@@ -405,7 +389,7 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   const double spare = double(runs.size()) - double(o.degree + 1);
   const double effective_dof =
       estimated_share > 0 && spare > 0 ? spare / (estimated_share * estimated_share) : 0.0;
-  double t = t_975(effective_dof);
+  double t = student_t_975(effective_dof);
   // Cross-validation across packings: the summaries' covariance, estimated from a few spare
   // runs, cannot see every direction in which one packing differs from another; fitting
   // twin runs of known friction with the other seeds' runs measures how far a realization
@@ -439,7 +423,7 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
       fit.cross_validated_sigma = std::sqrt(sum2 / double(fit.cross_validations));
       if (fit.cross_validated_sigma > fit.log_mu_s_sigma) {
         fit.log_mu_s_sigma = fit.cross_validated_sigma;
-        t = t_975(double(fit.cross_validations));
+        t = student_t_975(double(fit.cross_validations));
       }
     }
   }

@@ -139,4 +139,11 @@ Table probability_density(const std::vector<double>& values, const DensityOption
   return t;
 }
 
+double student_t_975(double dof) {
+  const double z = 1.959964, z3 = z * z * z, z5 = z3 * z * z;
+  if (!(dof > 0) || !std::isfinite(dof)) return z;
+  return z + (z3 + z) / (4 * dof) + (5 * z5 + 16 * z3 + 3 * z) / (96 * dof * dof) +
+         (3 * z5 * z * z + 19 * z5 + 17 * z3 - 15 * z) / (384 * dof * dof * dof);
+}
+
 }  // namespace granmem

@@ -1,0 +1,57 @@
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace granmem {
+
+// One twin run: its sliding friction, its packing's seed, and the steady-state values of
+// the observables (window means: packing fraction, wall force, mean rotation, ...), in the
+// same order as the experiment's.
+struct ObservableRun {
+  double mu_s = 0;
+  std::uint64_t seed = 1;
+  std::vector<double> values;
+};
+
+struct ObservableFitOptions {
+  // Each observable across the runs as a polynomial of this degree in ln(mu_s).
+  int degree = 2;
+  // With runs of two seeds or more: each run at an interior friction, taken as the
+  // experiment, is fitted with the other seeds' runs; the RMS of ln(fitted / true) is how
+  // far one packing moves the fit, and the interval takes it when it is the larger error.
+  bool cross_validate = true;
+};
+
+struct ObservableFit {
+  double mu_s = 0;
+  std::array<double, 2> mu_s_ci95{0, 0};
+  double log_mu_s_sigma = 0;  // standard error of ln(mu_s) that sets the interval
+  double chi2 = 0, dof = 0;   // at the fit; dof = observables - 1
+  double error_scale = 1;     // sqrt(chi2 / dof) when above 1
+  double cross_validated_sigma = 0;
+  std::size_t cross_validations = 0;
+  std::vector<double> scatter;     // per observable: the runs' scatter about the trend
+  std::vector<double> resolution;  // per observable: its own error in ln(mu_s) at the fit
+  std::vector<double> model;       // the observables predicted at the fit
+  std::size_t simulations = 0;
+  std::string method;
+};
+
+// Fits mu_s so that the twin's steady-state observables match the experiment's: each
+// observable is a polynomial in ln(mu_s) fitted across the runs; the runs' residuals about
+// it give the covariance of one packing's values (realization noise, shrunk towards its
+// diagonal as the runs' spare degrees of freedom are few); the experiment, one packing,
+// has that covariance, and the trend its leverage's share. Ceres minimizes the generalized
+// least squares over ln(mu_s) within the runs' range; the 95 % interval is from its
+// covariance (Student's t for the spare runs), widened by sqrt(chi2/dof) on a misfit, or
+// from the cross-validation across packings when that error is larger. Throws Error for
+// fewer runs than degree + 2, runs of one friction, or values of unequal count.
+ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
+                                          const std::vector<ObservableRun>& runs,
+                                          const ObservableFitOptions& options = {});
+
+}  // namespace granmem

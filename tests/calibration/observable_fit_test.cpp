@@ -1,0 +1,116 @@
+// The friction fit on steady-state observables: on synthetic twins whose packings differ
+// by a shared offset and noise the 95 % interval holds the truth at its rate; on the real
+// DEM runs of docs/CALIBRATION.md a packing left out is fitted within its interval.
+#include "granmem/calibration/observable_fit.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+namespace {
+
+// Three observables with trends in ln mu_s like the lid's packing fraction, the wall force
+// and the rotation; a packing adds an offset shared across frictions (correlated between
+// the first two, as a denser packing pushes less) and each run its own noise.
+struct Synthetic {
+  std::mt19937_64 random;
+  std::normal_distribution<double> normal{0, 1};
+  std::vector<double> values(double mu, const std::vector<double>& packing) {
+    const double x = std::log(mu);
+    return {0.55 - 0.015 * x - 0.002 * x * x + packing[0] + 0.001 * normal(random),
+            7.5 + 2.0 * x + packing[1] + 0.15 * normal(random),
+            0.016 + 0.003 * x + packing[2] + 0.0006 * normal(random)};
+  }
+  std::vector<double> packing() {
+    const double shared = normal(random);
+    return {0.001 * shared, -0.2 * shared + 0.1 * normal(random), 0.0004 * normal(random)};
+  }
+};
+
+TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
+  Synthetic s{std::mt19937_64(11)};
+  const std::vector<double> frictions{0.05, 0.1, 0.2, 0.3, 0.5};
+  int held = 0, trials = 0;
+  double width = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    std::vector<ObservableRun> runs;
+    for (std::uint64_t seed : {1, 2}) {
+      const std::vector<double> packing = s.packing();
+      for (double mu : frictions)
+        runs.push_back({mu, seed, s.values(mu, packing)});
+    }
+    const double truth =
+        std::exp(std::log(0.07) +
+                 (std::log(0.4) - std::log(0.07)) * std::uniform_real_distribution<>()(s.random));
+    const ObservableFit fit = fit_friction_to_observables(s.values(truth, s.packing()), runs);
+    ++trials;
+    held += fit.mu_s_ci95[0] <= truth && truth <= fit.mu_s_ci95[1];
+    width += std::log(fit.mu_s_ci95[1] / fit.mu_s_ci95[0]) / 150;
+    EXPECT_EQ(fit.simulations, 10u);
+  }
+  const double coverage = double(held) / trials;
+  RecordProperty("coverage", std::to_string(coverage));
+  RecordProperty("mean_ln_width", std::to_string(width));
+  std::printf("coverage %.3f, mean ln width %.3f\n", coverage, width);
+  EXPECT_GE(coverage, 0.88) << held << " of " << trials;
+  EXPECT_LT(width, 1.0);  // informative: the interval spans well under a factor e
+}
+
+// Window means over cycles 41-60 of the runs in docs/data/friction/per_run.csv (1,500
+// grains, 436 Pa, A = 1 %): rotation / d, bulk packing fraction and coordination from
+// positions, packing fraction from the lid, wall force at full compression (N).
+struct DemRun {
+  double mu;
+  std::uint64_t seed;
+  std::vector<double> values;
+};
+const std::vector<DemRun> kDemRuns = {
+    {0.05, 1, {0.00860899, 0.624011, 7.03868, 0.594227, 3.78195}},
+    {0.05, 2, {0.00824997, 0.621255, 6.80999, 0.591677, 3.49115}},
+    {0.1, 1, {0.00961908, 0.620488, 6.93531, 0.583462, 5.1988}},
+    {0.1, 2, {0.0107892, 0.620165, 6.87843, 0.585635, 4.73173}},
+    {0.2, 1, {0.0129084, 0.615324, 6.69724, 0.576276, 6.37223}},
+    {0.2, 2, {0.0134513, 0.615235, 6.62663, 0.576264, 6.04276}},
+    {0.3, 1, {0.0140207, 0.601216, 6.50962, 0.565818, 7.58724}},
+    {0.3, 2, {0.0141037, 0.604235, 6.43488, 0.563245, 7.1794}},
+    {0.5, 1, {0.0158644, 0.596833, 6.16725, 0.556519, 8.45497}},
+    {0.5, 2, {0.0183237, 0.600304, 6.1847, 0.557426, 8.03147}},
+};
+
+// One packing's runs are the twin, the other's at interior frictions the experiments: the
+// fit lands within 0.035 of the truth. With one packing in the twin its intervals see only
+// the scatter about the trend, not a packing's shared offset (the wall force of seed 1 is
+// 0.3-0.5 N higher at every friction): 5 of these 6 hold the truth, one misses by 0.004 —
+// the reason the twin needs two packings or more, and the fit cross-validates across them.
+TEST(ObservableFit, APackingLeftOutOfRealDemRunsIsFittedWithinPointZeroThreeFive) {
+  int held = 0;
+  for (std::uint64_t left_out : {1, 2}) {
+    std::vector<ObservableRun> twin;
+    for (const DemRun& r : kDemRuns)
+      if (r.seed != left_out) twin.push_back({r.mu, r.seed, r.values});
+    for (const DemRun& r : kDemRuns) {
+      if (r.seed != left_out || r.mu == 0.05 || r.mu == 0.5) continue;
+      const ObservableFit fit = fit_friction_to_observables(r.values, twin);
+      SCOPED_TRACE("seed " + std::to_string(left_out) + " at mu_s " + std::to_string(r.mu));
+      EXPECT_NEAR(fit.mu_s, r.mu, 0.035);
+      held += fit.mu_s_ci95[0] <= r.mu && r.mu <= fit.mu_s_ci95[1];
+    }
+  }
+  EXPECT_GE(held, 5);
+}
+
+TEST(ObservableFit, TooFewRunsOrMismatchedObservablesAreRefused) {
+  const std::vector<ObservableRun> three{{0.1, 1, {1, 2}}, {0.2, 1, {2, 3}}, {0.3, 1, {3, 4}}};
+  EXPECT_THROW(fit_friction_to_observables({1.5, 2.5}, three), Error);
+  std::vector<ObservableRun> four = three;
+  four.push_back({0.4, 1, {4}});
+  EXPECT_THROW(fit_friction_to_observables({1.5, 2.5}, four), Error);
+}
+
+}  // namespace
+}  // namespace granmem

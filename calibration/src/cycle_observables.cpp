@@ -160,4 +160,53 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
   return f;
 }
 
+double SteadyState::operator[](const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() ? std::nan("") : values[std::size_t(it - names.begin())];
+}
+
+SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
+                         const StructureOptions& structure) {
+  const auto [first, last] = observed.window;
+  auto in_window = [&](std::int64_t c) { return c >= first && c <= last; };
+  SteadyState s;
+  auto mean_of = [&](const std::vector<std::int64_t>& cycle, const std::vector<double>& value) {
+    double sum = 0;
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < cycle.size() && k < value.size(); ++k) {
+      if (in_window(cycle[k]) && std::isfinite(value[k])) {
+        sum += value[k];
+        ++n;
+      }
+    }
+    return n ? sum / double(n) : std::nan("");
+  };
+  const double rot = mean_of(observed.cycle, observed.mean_rot_disp);
+  if (std::isfinite(rot)) {
+    s.names.push_back("rot_disp");
+    s.values.push_back(rot);
+  }
+  std::vector<std::int64_t> cycles;
+  std::vector<double> packing, coordination;
+  for (std::size_t t = 0; t < run.frame_count(); ++t) {
+    if (!in_window(run.steps()[t])) continue;
+    const PackingStructure p =
+        packing_structure(run.read_frame(t).position, run.header().radius, structure);
+    cycles.push_back(run.steps()[t]);
+    packing.push_back(p.packing_fraction);
+    coordination.push_back(p.coordination);
+  }
+  s.names.insert(s.names.end(), {"bulk_packing_fraction", "coordination"});
+  s.values.insert(s.values.end(), {mean_of(cycles, packing), mean_of(cycles, coordination)});
+  for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
+    const auto it = run.observables().find(name);
+    if (it == run.observables().end()) continue;
+    const double v = mean_of(it->second.step, it->second.value);
+    if (!std::isfinite(v)) continue;
+    s.names.push_back(name);
+    s.values.push_back(v);
+  }
+  return s;
+}
+
 }  // namespace granmem

@@ -9,6 +9,7 @@
 
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/rotation/grain_motion.hpp"
+#include "granmem/rotation/packing_structure.hpp"
 
 namespace granmem {
 
@@ -69,6 +70,23 @@ struct DisplacementField {
 DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
                                          const TrajectoryReader& full_compression,
                                          std::int64_t cycle, const ObservableOptions& options);
+
+// The steady state of a run over the window of `observed` (cycle_observables of the same
+// run): the window means of what carries friction (docs/CALIBRATION.md), measured alike in
+// scans and simulations, then the store's own observables where it has them:
+//   rot_disp                     single-axis rotational displacement, diameters (axes)
+//   bulk_packing_fraction        from positions (packing_structure.hpp)
+//   coordination                 from positions
+//   packing_fraction             from the lid height (simulations; the store's)
+//   wall_force_full_compression  N (the store's)
+struct SteadyState {
+  std::vector<std::string> names;
+  std::vector<double> values;
+  // The value of `name`, NaN when the run has none.
+  double operator[](const std::string& name) const;
+};
+SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
+                         const StructureOptions& structure = {});
 
 // Twice the median finite grain radius of the run, m (Error if it has none).
 double median_diameter(const TrajectoryReader& run);

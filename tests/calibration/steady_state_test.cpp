@@ -1,0 +1,69 @@
+// The steady state of a run: window means of the rotation, the bulk structure from
+// positions and the store's own observables, on a run whose every value is known.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "temp_dir.hpp"
+
+namespace granmem {
+namespace {
+
+constexpr double kTurn = 0.02;  // rad per cycle, about x
+
+// A simple cubic packing of 1 mm grains, 1 mm apart (touching), turning every grain's
+// cavity axis by kTurn each cycle and shifting it by 0.01 mm; the store's observables
+// say 10 c (wall force) and 0.5 + 0.01 c (packing fraction) at cycle c.
+Trajectories cubic_run() {
+  Trajectories run;
+  RunHeader& h = run.header;
+  h.length_unit = "mm";
+  h.time_unit = "cycle";
+  h.has_axis = true;
+  const int n = 8;
+  for (int k = 0; k < n * n * n; ++k) {
+    h.id.push_back(k);
+    h.radius.push_back(0.5);
+  }
+  for (int c = 0; c <= 4; ++c) {
+    Frame f = Frame::unknown(h);
+    f.step = c;
+    f.time = c;
+    for (int k = 0; k < n * n * n; ++k) {
+      f.position.row(k) << k % n + 0.01 * c, (k / n) % n, k / (n * n);
+      f.axis.row(k) << 0, -std::sin(kTurn * c), std::cos(kTurn * c);
+    }
+    run.frames.push_back(f);
+    for (const char* name : {"wall_force_full_compression", "packing_fraction"}) {
+      Observable& o = run.observables[name];
+      o.unit = name[0] == 'w' ? "N" : "1";
+      o.step.push_back(c);
+      o.time.push_back(c);
+      o.value.push_back(name[0] == 'w' ? 10.0 * c : 0.5 + 0.01 * c);
+    }
+  }
+  return run;
+}
+
+class SteadyStateTest : public testing::TempDirTest {};
+
+TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservables) {
+  write_trajectories(path("run.h5"), cubic_run());
+  const TrajectoryReader run(path("run.h5"));
+  ObservableOptions o;
+  o.window = {3, 4};
+  const SteadyState s = steady_state(run, cycle_observables(run, o));
+  EXPECT_EQ(s.names, (std::vector<std::string>{"rot_disp", "bulk_packing_fraction", "coordination",
+                                               "packing_fraction", "wall_force_full_compression"}));
+  EXPECT_NEAR(s["rot_disp"], kTurn / 2, 1e-12);  // angle x d/2, in diameters
+  EXPECT_NEAR(s["bulk_packing_fraction"], M_PI / 6, 1e-12);
+  EXPECT_DOUBLE_EQ(s["coordination"], 6);
+  EXPECT_DOUBLE_EQ(s["packing_fraction"], 0.535);  // cycles 3 and 4 only
+  EXPECT_DOUBLE_EQ(s["wall_force_full_compression"], 35);
+  EXPECT_TRUE(std::isnan(s["lid_height"]));
+}
+
+}  // namespace
+}  // namespace granmem

@@ -114,11 +114,15 @@ column -s, -t < "$sens" | sed -n '2,$p'
 command -v gnuplot > /dev/null || { echo "friction_sensitivity.sh: gnuplot not found, no figure" >&2; exit 0; }
 grep -v '^#' "$per_run" | tail -n +2 | sort -t, -k2,2n -k1,1g |
   awk -F, 'NR > 1 && $2 != seed { print "\n" } { seed = $2; print }' > "$out/per_run.dat"
+seed_names=$(grep -v '^#' "$per_run" | tail -n +2 | cut -d, -f2 | sort -un | tr '\n' ' ')
+seeds=$(echo $seed_names | wc -w)
 gnuplot <<GNUPLOT
+seed_names = "$seed_names"
+colours = "#440154 #21918c #fde725 #3b528b #5ec962"
 set terminal pngcairo size 1500,900 font "sans,11"
 set output "$out/sensitivity.png"
 set datafile separator ","
-set multiplot layout 2,3 title "Steady state (cycles $window) against sliding friction: 1,500 grains, 5 cm box, 436 Pa, A = 1 %, two packings"
+set multiplot layout 2,3 title "Steady state (cycles $window) against sliding friction: 1,500 grains, 5 cm box, 436 Pa, A = 1 %, one line per packing"
 set logscale x
 set xrange [0.04:0.6]
 set xlabel "mu_s"
@@ -128,8 +132,8 @@ labels = "'end-of-cycle displacement / d' 'rotational displacement / d' 'bulk pa
 do for [k = 3:8] {
   set ylabel word(labels, k - 2)
   if (k == 5 || k == 6 || k == 7) { set key top right } else { set key top left }
-  plot "$out/per_run.dat" index 0 using 1:k with linespoints pt 7 lc rgb "#440154" title "seed 1", \
-       "" index 1 using 1:k with linespoints pt 5 lc rgb "#21918c" title "seed 2"
+  plot for [i = 0:$((seeds - 1))] "$out/per_run.dat" index i using 1:k with linespoints \
+       pt 7 lc rgb word(colours, i + 1) title sprintf("seed %s", word(seed_names, i + 1))
 }
 unset multiplot
 GNUPLOT

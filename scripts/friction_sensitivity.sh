@@ -17,6 +17,7 @@
 #
 # Writes per_run.csv and sensitivity.csv in --out (default docs/data/friction).
 set -euo pipefail
+source "$(dirname "$0")/lib/run_tables.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 runs="$root/out/friction_scan"
@@ -39,14 +40,9 @@ done
 [[ -x $granmem ]] || { echo "friction_sensitivity.sh: no granmem at $granmem" >&2; exit 1; }
 command -v h5dump > /dev/null || { echo "friction_sensitivity.sh: h5dump not found (hdf5-tools)" >&2; exit 1; }
 mkdir -p "$out" "$runs/report"
-d_m=$(awk -v d="$diameter" 'BEGIN { v = d + 0; if (d ~ /mm$/) v /= 1000; else if (d ~ /cm$/) v /= 100; print v }')
+d_m=$(in_metres "$diameter")
 first=${window%%:*}
 last=${window##*:}
-
-observable() {  # file name: values, one per line (frame 0 first)
-  h5dump -m %.10g -d "/observables/$2/value" -y -w 0 "$1" |
-    awk '/DATA \{/ { on = 1; next } on && /\}/ { exit } on { gsub(/,/, " "); for (k = 1; k <= NF; k++) print $k }'
-}
 
 names=$(for f in "$runs"/*.done; do if [[ -e $f ]]; then basename "$f" .done; fi; done)
 [[ -n $names ]] || { echo "friction_sensitivity.sh: no finished runs in $runs" >&2; exit 1; }

@@ -13,6 +13,7 @@
 # from the runs' observables (h5dump). Writes per_cycle.csv, steady_state.csv and
 # quasistatic.png (gnuplot) in --out (default docs/data/quasistatic).
 set -euo pipefail
+source "$(dirname "$0")/lib/run_tables.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 runs="$root/out/quasistatic"
@@ -37,15 +38,10 @@ command -v h5dump > /dev/null || { echo "quasistatic_report.sh: h5dump not found
 mkdir -p "$out"
 work="$runs/report"
 mkdir -p "$work"
-d_m=$(awk -v d="$diameter" 'BEGIN { v = d + 0; if (d ~ /mm$/) v /= 1000; else if (d ~ /cm$/) v /= 100; print v }')
+d_m=$(in_metres "$diameter")
 first=${window%%:*}
 last=${window##*:}
 
-# Values of an observable, one per line (frame 0 first).
-observable() {
-  h5dump -m %.10g -d "/observables/$2/value" -y -w 0 "$1" |
-    awk '/DATA \{/ { on = 1; next } on && /\}/ { exit } on { gsub(/,/, " "); for (k = 1; k <= NF; k++) print $k }'
-}
 # name -> mu, seed, inertial number
 parse() { echo "$1" | sed -E 's/^mu([^_]+)_seed([^_]+)_I(.+)$/\1 \2 \3/'; }
 # "mean_a mean_b ks ks_p" of quantity row q (1 = dr, 2 = rot_disp) of a distances.csv

@@ -11,8 +11,10 @@
 
 #include "commands.hpp"
 #include "comparison_report.hpp"
+#include "granmem/calibration/figures.hpp"
 #include "granmem/calibration/friction_fit.hpp"
 #include "granmem/calibration/friction_series.hpp"
+#include "granmem/calibration/observable_fit.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
@@ -87,14 +89,114 @@ std::string json_text(const std::string& s) {
   return q + "\"";
 }
 
+std::string settings_json(const std::map<std::string, std::string>& settings) {
+  std::string j = "{";
+  for (const auto& [key, value] : settings)
+    j += (j.size() > 1 ? ", " : "") + json_text(key) + ": " + json_text(value);
+  return j + "}";
+}
+
+// Three digits: the best run's file name, and a second call finds it.
+double three_digits(double x) {
+  char rounded[32];
+  std::snprintf(rounded, sizeof rounded, "%.3g", x);
+  return std::stod(rounded);
+}
+
+// The steady-state fit's outputs: the runs' window means (steady_state_runs.csv), the
+// figure, and the summary's per-observable part.
+struct SteadyStateOutputs {
+  std::vector<std::filesystem::path> written;
+  std::string json;  // the "observables" member of summary.json
+};
+
+SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableFit& fit,
+                                          const SteadyState& experiment,
+                                          const std::vector<SteadyStateRun>& runs,
+                                          double true_mu_s) {
+  SteadyStateOutputs o;
+  Table t;
+  Column& mu = t.add("mu_s");
+  Column& seed = t.add("seed", "", true);
+  std::vector<Column*> value;
+  for (const std::string& name : fit.names)
+    value.push_back(&t.add(name));
+  for (const SteadyStateRun& r : runs) {
+    mu.values.push_back(r.mu_s);
+    seed.values.push_back(double(r.seed));
+    for (std::size_t k = 0; k < fit.names.size(); ++k)
+      value[k]->values.push_back(r.state[fit.names[k]]);
+  }
+  write_csv(t, out / "steady_state_runs.csv",
+            {"the twin's steady state: window means per run (rot_disp in grain diameters, "
+             "wall force in N)"});
+  o.written.push_back(out / "steady_state_runs.csv");
+
+  std::map<std::uint64_t, int> packing;
+  for (const SteadyStateRun& r : runs)
+    packing.emplace(r.seed, int(packing.size()));
+  std::vector<ObservablePanel> panels;
+  std::ostringstream j;
+  j << "{";
+  for (std::size_t k = 0; k < fit.names.size(); ++k) {
+    ObservablePanel p;
+    p.label = steady_state_label(fit.names[k]);
+    for (const SteadyStateRun& r : runs) {
+      p.run_mu_s.push_back(r.mu_s);
+      p.run_value.push_back(r.state[fit.names[k]]);
+      p.run_packing.push_back(packing.at(r.seed));
+    }
+    p.curve_mu_s = fit.curve_mu_s;
+    p.curve = fit.curve[k];
+    p.experiment = experiment[fit.names[k]];
+    p.experiment_error = fit.scatter[k];
+    panels.push_back(std::move(p));
+    j << (k ? ", " : "") << json_text(fit.names[k])
+      << ": {\"experiment\": " << json_number(experiment[fit.names[k]])
+      << ", \"model_at_fit\": " << json_number(fit.model[k])
+      << ", \"packing_scatter\": " << json_number(fit.scatter[k])
+      << ", \"log_mu_s_resolution\": " << json_number(fit.resolution[k]) << "}";
+  }
+  j << "}";
+  o.json = j.str();
+  char title[160];
+  std::snprintf(title, sizeof title, "steady-state fit: mu_s = %.3g (95%% %.3g-%.3g)%s", fit.mu_s,
+                fit.mu_s_ci95[0], fit.mu_s_ci95[1],
+                std::isfinite(true_mu_s) ? (", true " + json_number(true_mu_s)).c_str() : "");
+  const auto figure =
+      plot_observable_fit(out, "observable_fit", panels, fit.mu_s, fit.mu_s_ci95, true_mu_s, title);
+  o.written.insert(o.written.end(), figure.begin(), figure.end());
+  return o;
+}
+
+// The experiment's friction where granmem simulated it (a pseudo-experiment), else NaN.
+double true_friction(const RunHeader& experiment) {
+  const auto it = experiment.parameters.find("simulate/mu-s");
+  if (it == experiment.parameters.end()) return std::nan("");
+  try {
+    return std::stod(it->second);
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
+std::vector<std::string> parse_names(const std::string& text) {
+  std::vector<std::string> names;
+  std::stringstream in(text);
+  for (std::string name; std::getline(in, name, ',');)
+    if (!trim(name).empty()) names.emplace_back(trim(name));
+  return names;
+}
+
 }  // namespace
 
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
     std::string experiment, out, mu_s = "0.03,0.05,0.08,0.12,0.2,0.3,0.5", window, noise = "auto",
-                                 wall_distance = "0", preparation = "each", summaries = "pooled";
+                                 wall_distance = "0", preparation = "each", summaries = "pooled",
+                                 observables = "displacements", only;
     std::map<std::string, std::string> twin;
-    bool keep_drift = false;
+    bool keep_drift = false, fit_only = false;
     int threads = 0, degree = 2, replicas = 2;
   };
   auto args = std::make_shared<Args>();
@@ -140,6 +242,20 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "deposition, where friction shows in how the displacements change)")
       ->capture_default_str()
       ->check(CLI::IsMember({"pooled", "per-cycle"}));
+  cmd->add_option("--observables", args->observables,
+                  "displacements: the distribution of end-of-cycle displacements (--summaries); "
+                  "steady-state: the window means of the rotation, the packing fraction and "
+                  "coordination from positions, and the lid's packing fraction and the wall "
+                  "force where the experiment has them (docs/CALIBRATION.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"displacements", "steady-state"}));
+  cmd->add_option("--only", args->only,
+                  "steady-state: fit only these observables, comma list (rot_disp, "
+                  "bulk_packing_fraction, coordination, packing_fraction, "
+                  "wall_force_full_compression); default all the experiment has");
+  cmd->add_flag("--fit-only", args->fit_only,
+                "steady-state: fit and stop; no run at the fitted friction, so no distances "
+                "or comparison figures (one simulation fewer)");
   cmd->add_option("--threads", args->threads, "runs at once (default: all cores)");
   // The twin's settings: as `simulate` takes them, here or in the config's [simulate].
   std::map<std::string, CLI::Option*> given;
@@ -315,6 +431,68 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       for (double m : mu)
         specs.push_back({m, seed});
     run_all(specs);
+    if (args->observables == "steady-state") {
+      std::vector<SteadyStateRun> twin;
+      for (const FrictionRunSpec& run : specs) {
+        const TrajectoryReader r(friction_run_path(series.dir, run));
+        twin.push_back({run.mu_s, run.seed, steady_state(r, cycle_observables(r, observe))});
+      }
+      ObservableFitOptions fo;
+      fo.degree = args->degree;
+      const SteadyState exp_state = steady_state(experiment, measured);
+      const ObservableFit fit =
+          fit_friction_to_steady_state(exp_state, twin, fo, parse_names(args->only));
+      const FrictionRunSpec best_spec{three_digits(fit.mu_s), d.seed};
+      Comparison compared;
+      if (!args->fit_only) {
+        run_all({best_spec});
+        if (!mpi_ranks().root()) return;
+        compared = compare_runs(
+            experiment, TrajectoryReader(friction_run_path(series.dir, best_spec)), "experiment",
+            "DEM mu_s = " + json_number(best_spec.mu_s), observe, Eigen::Vector3d::Zero(), 0, out);
+      } else if (!mpi_ranks().root()) {
+        return;
+      }
+      const double truth = true_friction(h);
+      SteadyStateOutputs written = write_steady_state_fit(out, fit, exp_state, twin, truth);
+      const std::size_t simulations =
+          specs.size() +
+          (args->fit_only || std::count(mu.begin(), mu.end(), best_spec.mu_s) ? 0 : 1);
+      {
+        AtomicFile f(out / "summary.json");
+        std::ofstream j(f.temp_path());
+        j << "{\n  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
+          << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
+          << "],\n  \"mu_s_true\": " << json_number(truth)
+          << ",\n  \"mu_s_interval_method\": " << json_text(fit.method)
+          << ",\n  \"log_mu_s_sigma\": " << json_number(fit.log_mu_s_sigma)
+          << ",\n  \"gls_sigma\": " << json_number(fit.gls_sigma)
+          << ",\n  \"cross_validated_sigma\": " << json_number(fit.cross_validated_sigma)
+          << ",\n  \"chi2\": " << json_number(fit.chi2) << ",\n  \"dof\": " << json_number(fit.dof)
+          << ",\n  \"n_simulations\": " << simulations << ",\n  \"replicas\": " << args->replicas
+          << ",\n  \"observables\": " << written.json << ",\n  \"window\": ["
+          << observe.window.first << ", " << observe.window.second
+          << "],\n  \"experiment\": " << json_text(args->experiment)
+          << ",\n  \"settings\": " << settings_json(v) << "\n}\n";
+        j.close();
+        f.commit();
+      }
+      std::cout << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval "
+                << fit.mu_s_ci95[0] << " - " << fit.mu_s_ci95[1] << ", " << simulations
+                << " simulations)";
+      if (std::isfinite(truth)) std::cout << "  true " << truth;
+      std::cout << "\n  steady state over cycles " << observe.window.first << "-"
+                << observe.window.second << ":";
+      for (std::size_t k = 0; k < fit.names.size(); ++k)
+        std::cout << (k ? ", " : " ") << fit.names[k] << " (+-" << fit.resolution[k]
+                  << " in ln mu_s)";
+      std::cout << "\n  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
+                << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
+                << " in ln mu_s on " << fit.cross_validations << " runs\n"
+                << "wrote " << (out / "summary.json").string() << ", steady_state_runs.csv, "
+                << written.written.size() + compared.written.size() << " figure files\n";
+      return;
+    }
     std::vector<FrictionRun> runs;
     for (const FrictionRunSpec& run : specs)
       runs.push_back(
@@ -324,9 +502,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     const FrictionFit fit = fit_friction(measured, runs, fit_options);
 
     // The twin at the fitted friction: what the distances and the figures compare.
-    char rounded[32];  // three digits: the run's file name, and a second call finds it
-    std::snprintf(rounded, sizeof rounded, "%.3g", fit.mu_s);
-    const double best = std::stod(rounded);
+    const double best = three_digits(fit.mu_s);
     const FrictionRunSpec best_spec{best, d.seed};
     run_all({best_spec});
     if (!mpi_ranks().root()) return;  // in an MPI job, rank 0 writes the results
@@ -421,13 +597,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
         << ", \"wasserstein1_rot_disp\": " << json_number(w1_rot)
         << ", \"length_unit\": \"grain diameter\"},\n  \"window\": [" << observe.window.first
         << ", " << observe.window.second << "],\n  \"experiment\": " << json_text(args->experiment)
-        << ",\n  \"settings\": {";
-      bool first = true;
-      for (const auto& [key, value] : v) {
-        j << (first ? "" : ", ") << json_text(key) << ": " << json_text(value);
-        first = false;
-      }
-      j << "}\n}\n";
+        << ",\n  \"settings\": " << settings_json(v) << "\n}\n";
       j.close();
       f.commit();
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
@@ -163,6 +164,17 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
 double SteadyState::operator[](const std::string& name) const {
   const auto it = std::find(names.begin(), names.end(), name);
   return it == names.end() ? std::nan("") : values[std::size_t(it - names.begin())];
+}
+
+std::string steady_state_label(const std::string& name) {
+  static const std::map<std::string, std::string> labels{
+      {"rot_disp", "rotational displacement (d)"},
+      {"bulk_packing_fraction", "bulk packing fraction (positions)"},
+      {"coordination", "coordination number (positions)"},
+      {"packing_fraction", "packing fraction (lid height)"},
+      {"wall_force_full_compression", "wall force at full compression (N)"}};
+  const auto it = labels.find(name);
+  return it == labels.end() ? name : it->second;
 }
 
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,

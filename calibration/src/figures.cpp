@@ -16,6 +16,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// A perceptual, colour-blind-safe map (matplotlib's viridis, 9 stops).
+constexpr const char* kViridis =
+    "set palette defined (0 '#440154', 1 '#472d7b', 2 '#3b528b', 3 '#2c728e', 4 '#21918c', "
+    "5 '#28ae80', 6 '#5ec962', 7 '#addc30', 8 '#fde725')";
+
 std::string quoted(const std::string& text) {
   std::string q = "\"";
   for (char c : text) {
@@ -162,8 +167,8 @@ std::vector<fs::path> plot_fields(const fs::path& dir, const std::string& name,
   std::ostringstream data, plot;
   data.precision(8);
   plot << "set multiplot layout 1," << panels.size() << "\nset size ratio -1\nunset key\n"
-       << "set palette rgbformulae 33,13,10\nset cbrange [0:" << top << "]\nset cblabel "
-       << quoted(value_label) << "\nset xlabel " << quoted("y " + axis_label) << "\nset ylabel "
+       << kViridis << "\nset cbrange [0:" << top << "]\nset cblabel " << quoted(value_label)
+       << "\nset xlabel " << quoted("y " + axis_label) << "\nset ylabel "
        << quoted("z " + axis_label) << "\n";
   for (std::size_t k = 0; k < panels.size(); ++k) {
     const Field& f = panels[k];
@@ -203,6 +208,69 @@ std::vector<fs::path> plot_curves(const fs::path& dir, const std::string& name,
   }
   plot << "\n";
   return draw(dir, name, data.str(), plot.str(), "900,600");
+}
+
+std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string& name,
+                                          const std::vector<ObservablePanel>& panels, double mu_s,
+                                          std::array<double, 2> ci95, double true_mu_s,
+                                          const std::string& title) {
+  if (panels.empty()) throw Error("observable fit figure: no observable");
+  const int columns = panels.size() > 4 ? 3 : std::min<int>(2, int(panels.size()));
+  const int rows = (int(panels.size()) + columns - 1) / columns;
+  double lowest = std::min(ci95[0], mu_s), highest = std::max(ci95[1], mu_s);
+  for (const ObservablePanel& panel : panels) {
+    for (double m : panel.run_mu_s) {
+      lowest = std::min(lowest, m);
+      highest = std::max(highest, m);
+    }
+  }
+  std::ostringstream data, plot;
+  data.precision(8);
+  plot << "set multiplot layout " << rows << "," << columns << " title " << quoted(title)
+       << "\nset logscale x\nset xlabel \"mu_s\"\nset key off\nset grid\n"
+       << "set xrange [" << lowest / 1.25 << ":" << highest * 1.25 << "]\n"
+       << "set object 1 rect from " << ci95[0] << ", graph 0 to " << ci95[1]
+       << ", graph 1 behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
+       << "set arrow 1 from " << mu_s << ", graph 0 to " << mu_s
+       << ", graph 1 nohead lw 2 lc rgb \"#b2182b\"\n";
+  if (std::isfinite(true_mu_s)) {
+    plot << "set arrow 2 from " << true_mu_s << ", graph 0 to " << true_mu_s
+         << ", graph 1 nohead lw 2 dt 2 lc rgb \"black\"\n";
+  }
+  for (std::size_t p = 0; p < panels.size(); ++p) {
+    const ObservablePanel& panel = panels[p];
+    data << "# " << panel.label << ": runs (mu_s, value, packing)\n";
+    for (std::size_t k = 0; k < panel.run_mu_s.size(); ++k)
+      data << panel.run_mu_s[k] << " " << panel.run_value[k] << " " << panel.run_packing[k] + 1
+           << "\n";
+    data << "\n\n# " << panel.label << ": trend (mu_s, value)\n";
+    for (std::size_t k = 0; k < panel.curve_mu_s.size(); ++k)
+      data << panel.curve_mu_s[k] << " " << panel.curve[k] << "\n";
+    data << "\n\n";
+    plot << "set ylabel " << quoted(panel.label) << "\nset object 2 rect from graph 0, first "
+         << panel.experiment - panel.experiment_error << " to graph 1, first "
+         << panel.experiment + panel.experiment_error
+         << " behind fc rgb \"#92c5de\" fs solid 0.45 noborder\n"
+         << "set arrow 3 from graph 0, first " << panel.experiment << " to graph 1, first "
+         << panel.experiment << " nohead lw 1.5 lc rgb \"#2166ac\"\n";
+    if (p + 1 == panels.size()) {
+      plot << "set key outside bottom center horizontal\n";
+    }
+    plot << "plot " << quoted(name + ".dat") << " index " << 2 * p
+         << " using 1:2:3 with points pt 7 ps 1.2 lc variable title \"twin runs (colour: "
+            "packing)\", "
+         << quoted(name + ".dat") << " index " << 2 * p + 1
+         << " using 1:2 with lines lw 2 lc rgb \"#404040\" title \"trend\", "
+         << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- one packing\", "
+         << "NaN with lines lw 8 lc rgb \"#f4a582\" title \"fitted mu_s, 95 %\""
+         << (std::isfinite(true_mu_s)
+                 ? ", NaN with lines lw 2 dt 2 lc rgb \"black\" title \"true mu_s\""
+                 : "")
+         << "\n";
+  }
+  plot << "unset multiplot\n";
+  const std::string size = std::to_string(420 * columns) + "," + std::to_string(330 * rows + 60);
+  return draw(dir, name, data.str(), plot.str(), size);
 }
 
 }  // namespace granmem

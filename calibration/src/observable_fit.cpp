@@ -161,6 +161,12 @@ void check_runs(const std::vector<double>& experiment, const std::vector<Observa
   if (!(hi > lo)) throw Error("observable fit: the runs must differ in mu_s");
 }
 
+constexpr int kCurvePoints = 60;
+
+bool by_friction(const ObservableRun& a, const ObservableRun& b) {
+  return a.mu_s < b.mu_s;
+}
+
 }  // namespace
 
 ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
@@ -175,7 +181,8 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
   fit.chi2 = f.chi2;
   fit.dof = double(experiment.size()) - 1;
   fit.error_scale = fit.dof > 0 ? std::max(1.0, std::sqrt(fit.chi2 / fit.dof)) : 1.0;
-  fit.log_mu_s_sigma = f.sigma * fit.error_scale;
+  fit.gls_sigma = f.sigma * fit.error_scale;
+  fit.log_mu_s_sigma = fit.gls_sigma;
   double t = student_t_975(f.trend.spare);
   fit.simulations = runs.size();
   const Eigen::VectorXd model = f.trend.predict(f.log_mu), slope = f.trend.slope(f.log_mu);
@@ -184,6 +191,15 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
     fit.model.push_back(model(o));
     fit.scatter.push_back(f.trend.scatter(o));
     fit.resolution.push_back(inflation * f.trend.scatter(o) / std::abs(slope(o)));
+  }
+  fit.curve.resize(std::size_t(target.size()));
+  const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end(), by_friction);
+  for (int k = 0; k <= kCurvePoints; ++k) {
+    const double x = std::log(lo->mu_s) + std::log(hi->mu_s / lo->mu_s) * k / kCurvePoints;
+    fit.curve_mu_s.push_back(std::exp(x));
+    const Eigen::VectorXd y = f.trend.predict(x);
+    for (Eigen::Index o = 0; o < target.size(); ++o)
+      fit.curve[std::size_t(o)].push_back(y(o));
   }
 
   // Cross-validation across packings: a run of known friction fitted with the other
@@ -227,6 +243,38 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
                (fit.cross_validations > 0 ? "; cross-validated across packings on " +
                                                 std::to_string(fit.cross_validations) + " runs"
                                           : std::string());
+  return fit;
+}
+
+ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
+                                           const std::vector<SteadyStateRun>& runs,
+                                           const ObservableFitOptions& options,
+                                           const std::vector<std::string>& only) {
+  std::vector<std::string> names;
+  for (const std::string& name : only.empty() ? experiment.names : only) {
+    const bool everywhere = std::isfinite(experiment[name]) &&
+                            std::all_of(runs.begin(), runs.end(), [&](const SteadyStateRun& r) {
+                              return std::isfinite(r.state[name]);
+                            });
+    if (everywhere) {
+      names.push_back(name);
+    } else if (!only.empty()) {
+      throw Error("observable fit: '" + name + "' is not measured in the experiment and every run");
+    }
+  }
+  if (names.empty()) throw Error("observable fit: no observable in the experiment and every run");
+  std::vector<double> measured;
+  for (const std::string& name : names)
+    measured.push_back(experiment[name]);
+  std::vector<ObservableRun> twin;
+  for (const SteadyStateRun& r : runs) {
+    ObservableRun run{r.mu_s, r.seed, {}};
+    for (const std::string& name : names)
+      run.values.push_back(r.state[name]);
+    twin.push_back(std::move(run));
+  }
+  ObservableFit fit = fit_friction_to_observables(measured, twin, options);
+  fit.names = names;
   return fit;
 }
 

@@ -5,9 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "granmem/core/error.hpp"
@@ -112,6 +114,56 @@ TEST(ObservableFit, APackingLeftOutOfRealDemRunsIsFittedWithinPointZeroThreeFive
     }
   }
   EXPECT_GE(held, 5);
+}
+
+const std::vector<std::string> kNames{"rot_disp", "bulk_packing_fraction", "coordination",
+                                      "packing_fraction", "wall_force_full_compression"};
+
+SteadyState steady(const std::vector<double>& values, std::size_t count) {
+  SteadyState s;
+  s.names.assign(kNames.begin(), kNames.begin() + std::ptrdiff_t(count));
+  s.values.assign(values.begin(), values.begin() + std::ptrdiff_t(count));
+  return s;
+}
+
+// A scan has no lid height nor wall force: the fit by name uses what the experiment and
+// every run have, gives the same answer as the fit on those columns, and its trend curve
+// spans the runs' frictions through the model at the fit.
+TEST(ObservableFit, ByNameTheFitUsesWhatTheExperimentAndEveryRunHave) {
+  std::vector<SteadyStateRun> twin;
+  std::vector<ObservableRun> columns;
+  for (const DemRun& r : kDemRuns) {
+    if (r.seed == 2 && r.mu == 0.2) continue;
+    twin.push_back({r.mu, r.seed, steady(r.values, 5)});
+    columns.push_back({r.mu, r.seed, {r.values.begin(), r.values.begin() + 3}});
+  }
+  const DemRun& experiment = kDemRuns[5];  // seed 2 at 0.2, as a scan: positions only
+  const ObservableFit fit = fit_friction_to_steady_state(steady(experiment.values, 3), twin);
+  ASSERT_EQ(fit.names, std::vector<std::string>(kNames.begin(), kNames.begin() + 3));
+  const ObservableFit same = fit_friction_to_observables(
+      {experiment.values.begin(), experiment.values.begin() + 3}, columns);
+  EXPECT_DOUBLE_EQ(fit.mu_s, same.mu_s);
+  ASSERT_EQ(fit.curve.size(), 3u);
+  EXPECT_NEAR(fit.curve_mu_s.front(), 0.05, 1e-12);
+  EXPECT_NEAR(fit.curve_mu_s.back(), 0.5, 1e-12);
+  // The curve is the trend: between its samples it brackets the model at the fit.
+  const auto k =
+      std::size_t(std::lower_bound(fit.curve_mu_s.begin(), fit.curve_mu_s.end(), fit.mu_s) -
+                  fit.curve_mu_s.begin());
+  ASSERT_GT(k, 0u);
+  for (std::size_t o = 0; o < 3; ++o) {
+    const double lo = std::min(fit.curve[o][k - 1], fit.curve[o][k]);
+    const double hi = std::max(fit.curve[o][k - 1], fit.curve[o][k]);
+    EXPECT_GE(fit.model[o], lo - 1e-12);
+    EXPECT_LE(fit.model[o], hi + 1e-12);
+  }
+  // Asked for by name, an observable the scan lacks is an error, not silently dropped.
+  EXPECT_THROW(fit_friction_to_steady_state(steady(experiment.values, 3), twin, {},
+                                            {"rot_disp", "wall_force_full_compression"}),
+               Error);
+  const ObservableFit two = fit_friction_to_steady_state(steady(experiment.values, 5), twin, {},
+                                                         {"packing_fraction", "rot_disp"});
+  EXPECT_EQ(two.names, (std::vector<std::string>{"packing_fraction", "rot_disp"}));
 }
 
 TEST(ObservableFit, TooFewRunsOrMismatchedObservablesAreRefused) {

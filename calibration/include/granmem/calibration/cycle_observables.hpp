@@ -87,6 +87,9 @@ struct SteadyState {
 };
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
                          const StructureOptions& structure = {});
+// What a steady-state observable is, with its unit, for tables and figures ("wall force at
+// full compression (N)"); the name itself for one it does not know.
+std::string steady_state_label(const std::string& name);
 
 // Twice the median finite grain radius of the run, m (Error if it has none).
 double median_diameter(const TrajectoryReader& run);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -60,5 +61,22 @@ struct Curve {
 std::vector<std::filesystem::path> plot_curves(
     const std::filesystem::path& dir, const std::string& name, const std::vector<Curve>& curves,
     const std::string& x_label, const std::string& y_label, const std::string& title, bool log_x);
+
+// A friction fit on steady-state observables, one panel per observable against mu_s (log):
+// the twin's runs (one colour per packing), the trend fitted through them, the
+// experiment's value as a band (+- one packing's scatter), the fitted mu_s and its 95 %
+// interval as a shaded band, and the true mu_s of a pseudo-experiment (NaN: unknown).
+struct ObservablePanel {
+  std::string label;  // the observable, with its unit
+  std::vector<double> run_mu_s, run_value;
+  std::vector<int> run_packing;  // 0, 1, ...: the colour
+  std::vector<double> curve_mu_s, curve;
+  double experiment = 0, experiment_error = 0;
+};
+std::vector<std::filesystem::path> plot_observable_fit(const std::filesystem::path& dir,
+                                                       const std::string& name,
+                                                       const std::vector<ObservablePanel>& panels,
+                                                       double mu_s, std::array<double, 2> ci95,
+                                                       double true_mu_s, const std::string& title);
 
 }  // namespace granmem

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "granmem/calibration/cycle_observables.hpp"
+
 namespace granmem {
 
 // One twin run: its sliding friction, its packing's seed, and the steady-state values of
@@ -32,11 +34,17 @@ struct ObservableFit {
   double log_mu_s_sigma = 0;  // standard error of ln(mu_s) that sets the interval
   double chi2 = 0, dof = 0;   // at the fit; dof = observables - 1
   double error_scale = 1;     // sqrt(chi2 / dof) when above 1
+  double gls_sigma = 0;       // the GLS fit's own standard error of ln(mu_s), widened on a misfit
   double cross_validated_sigma = 0;
   std::size_t cross_validations = 0;
   std::vector<double> scatter;     // per observable: the runs' scatter about the trend
   std::vector<double> resolution;  // per observable: its own error in ln(mu_s) at the fit
   std::vector<double> model;       // the observables predicted at the fit
+  // The trend through the runs, for figures: curve[o][k] is observable o at curve_mu_s[k],
+  // which spans the runs' range evenly in ln(mu_s).
+  std::vector<double> curve_mu_s;
+  std::vector<std::vector<double>> curve;
+  std::vector<std::string> names;  // the observables' names, where the caller gave them
   std::size_t simulations = 0;
   std::string method;
 };
@@ -53,5 +61,21 @@ struct ObservableFit {
 ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
                                           const std::vector<ObservableRun>& runs,
                                           const ObservableFitOptions& options = {});
+
+// One twin run's steady state (steady_state() of its window).
+struct SteadyStateRun {
+  double mu_s = 0;
+  std::uint64_t seed = 1;
+  SteadyState state;
+};
+
+// The same fit on the observables that the experiment and every run have, by name, in the
+// experiment's order (a scan has no lid height, a run without axes no rotations), or on
+// `only` where it is not empty (Error naming one that is missing). The fit's `names` says
+// which were used.
+ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
+                                           const std::vector<SteadyStateRun>& runs,
+                                           const ObservableFitOptions& options = {},
+                                           const std::vector<std::string>& only = {});
 
 }  // namespace granmem

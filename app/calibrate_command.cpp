@@ -32,19 +32,19 @@ namespace fs = std::filesystem;
 const std::set<std::string> kNotTwin{"out",  "checkpoint", "checkpoint-every",  "cycles",
                                      "mu-s", "track",      "samples-per-cycle", "full-compression"};
 
-std::vector<double> parse_frictions(const std::string& text) {
-  if (trim(text).empty()) throw Error("--mu-s: the range of frictions is empty");
+std::vector<double> parse_frictions(const std::string& text, const std::string& option) {
+  if (trim(text).empty()) throw Error(option + ": the range of frictions is empty");
   std::vector<double> mu;
-  for (const Quantity& q : parse_quantity_list(text, "--mu-s")) {
+  for (const Quantity& q : parse_quantity_list(text, option)) {
     if (!q.unit.empty() || !(q.value > 0) || !std::isfinite(q.value)) {
-      throw Error("--mu-s '" + text + "': expected positive frictions, e.g. 0.05,0.1,0.2,0.4");
+      throw Error(option + " '" + text + "': expected positive frictions, e.g. 0.05,0.1,0.2,0.4");
     }
     mu.push_back(q.value);
   }
   std::sort(mu.begin(), mu.end());
-  if (mu.empty()) throw Error("--mu-s: the range of frictions is empty");
+  if (mu.empty()) throw Error(option + ": the range of frictions is empty");
   if (std::adjacent_find(mu.begin(), mu.end()) != mu.end()) {
-    throw Error("--mu-s '" + text + "': a friction is listed twice");
+    throw Error(option + " '" + text + "': a friction is listed twice");
   }
   return mu;
 }
@@ -169,9 +169,10 @@ SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableF
   return o;
 }
 
-// The experiment's friction where granmem simulated it (a pseudo-experiment), else NaN.
-double true_friction(const RunHeader& experiment) {
-  const auto it = experiment.parameters.find("simulate/mu-s");
+// The experiment's friction (mu-s, mu-r) where granmem simulated it (a pseudo-experiment),
+// else NaN.
+double true_friction(const RunHeader& experiment, const std::string& key) {
+  const auto it = experiment.parameters.find("simulate/" + key);
   if (it == experiment.parameters.end()) return std::nan("");
   try {
     return std::stod(it->second);
@@ -188,13 +189,182 @@ std::vector<std::string> parse_names(const std::string& text) {
   return names;
 }
 
+// What a steady-state fit needs of the calibration: the experiment, the twin's runs (and
+// how to simulate one more), and where to write.
+struct SteadyStateJob {
+  const TrajectoryReader& experiment;
+  const std::string& experiment_path;
+  const CycleObservables& measured;
+  const ObservableOptions& observe;
+  const std::vector<FrictionRunSpec>& specs;
+  const fs::path& runs_dir;
+  const fs::path& out;
+  const std::map<std::string, std::string>& settings;
+  std::uint64_t seed;
+  int replicas, degree;
+  std::vector<std::string> only;
+  bool fit_only;
+  std::function<void(const std::vector<FrictionRunSpec>&)> run_all;
+};
+
+std::vector<SteadyStateRun> twin_steady_states(const SteadyStateJob& job) {
+  std::vector<SteadyStateRun> twin;
+  for (const FrictionRunSpec& run : job.specs) {
+    const TrajectoryReader r(friction_run_path(job.runs_dir, run));
+    twin.push_back(
+        {run.mu_s, run.seed, steady_state(r, cycle_observables(r, job.observe)), run.mu_r});
+  }
+  return twin;
+}
+
+// The twin at the fit (unless --fit-only): the distances and comparison figures.
+Comparison compare_at_fit(const SteadyStateJob& job, const FrictionRunSpec& best) {
+  if (job.fit_only) return {};
+  job.run_all({best});
+  if (!mpi_ranks().root()) return {};
+  std::string label = "DEM mu_s = " + json_number(best.mu_s);
+  if (best.mu_r >= 0) label += ", mu_r = " + json_number(best.mu_r);
+  return compare_runs(job.experiment, TrajectoryReader(friction_run_path(job.runs_dir, best)),
+                      "experiment", label, job.observe, Eigen::Vector3d::Zero(), 0, job.out);
+}
+
+// summary.json of a steady-state fit: `fitted` holds the fit's own members.
+void write_steady_state_summary(const SteadyStateJob& job, const std::string& fitted,
+                                const std::string& observables, std::size_t simulations) {
+  AtomicFile f(job.out / "summary.json");
+  std::ofstream j(f.temp_path());
+  j << "{\n"
+    << fitted << ",\n  \"n_simulations\": " << simulations << ",\n  \"replicas\": " << job.replicas
+    << ",\n  \"observables\": " << observables << ",\n  \"window\": [" << job.observe.window.first
+    << ", " << job.observe.window.second
+    << "],\n  \"experiment\": " << json_text(job.experiment_path)
+    << ",\n  \"settings\": " << settings_json(job.settings) << "\n}\n";
+  j.close();
+  f.commit();
+}
+
+std::size_t simulations_with(const SteadyStateJob& job, const FrictionRunSpec& best) {
+  const bool simulated = std::any_of(job.specs.begin(), job.specs.end(), [&](const auto& r) {
+    return r.mu_s == best.mu_s && r.seed == best.seed && r.mu_r == best.mu_r;
+  });
+  return job.specs.size() + (job.fit_only || simulated ? 0 : 1);
+}
+
+void print_observables(const std::vector<std::string>& names, const std::vector<double>* resolution,
+                       const SteadyStateJob& job) {
+  std::cout << "  steady state over cycles " << job.observe.window.first << "-"
+            << job.observe.window.second << ":";
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    std::cout << (k ? ", " : " ") << names[k];
+    if (resolution) std::cout << " (+-" << (*resolution)[k] << " in ln mu_s)";
+  }
+  std::cout << "\n";
+}
+
+void fit_steady_state(const SteadyStateJob& job) {
+  const std::vector<SteadyStateRun> twin = twin_steady_states(job);
+  ObservableFitOptions fo;
+  fo.degree = job.degree;
+  const SteadyState exp_state = steady_state(job.experiment, job.measured);
+  const ObservableFit fit = fit_friction_to_steady_state(exp_state, twin, fo, job.only);
+  const FrictionRunSpec best{three_digits(fit.mu_s), job.seed};
+  const Comparison compared = compare_at_fit(job, best);
+  if (!mpi_ranks().root()) return;
+  const double truth = true_friction(job.experiment.header(), "mu-s");
+  const SteadyStateOutputs written = write_steady_state_fit(job.out, fit, exp_state, twin, truth);
+  const std::size_t simulations = simulations_with(job, best);
+  std::ostringstream fitted;
+  fitted << "  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
+         << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
+         << "],\n  \"mu_s_true\": " << json_number(truth)
+         << ",\n  \"mu_s_interval_method\": " << json_text(fit.method)
+         << ",\n  \"log_mu_s_sigma\": " << json_number(fit.log_mu_s_sigma)
+         << ",\n  \"gls_sigma\": " << json_number(fit.gls_sigma)
+         << ",\n  \"cross_validated_sigma\": " << json_number(fit.cross_validated_sigma)
+         << ",\n  \"chi2\": " << json_number(fit.chi2) << ",\n  \"dof\": " << json_number(fit.dof);
+  write_steady_state_summary(job, fitted.str(), written.json, simulations);
+  std::cout << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval "
+            << fit.mu_s_ci95[0] << " - " << fit.mu_s_ci95[1] << ", " << simulations
+            << " simulations)";
+  if (std::isfinite(truth)) std::cout << "  true " << truth;
+  std::cout << "\n";
+  print_observables(fit.names, &fit.resolution, job);
+  std::cout << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
+            << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
+            << " in ln mu_s on " << fit.cross_validations << " runs\n"
+            << "wrote " << (job.out / "summary.json").string() << ", steady_state_runs.csv, "
+            << written.written.size() + compared.written.size() << " figure files\n";
+}
+
+void fit_joint(const SteadyStateJob& job) {
+  const std::vector<SteadyStateRun> twin = twin_steady_states(job);
+  ObservableFitOptions fo;
+  fo.degree = job.degree;
+  const SteadyState exp_state = steady_state(job.experiment, job.measured);
+  const JointObservableFit fit = fit_frictions_to_steady_state(exp_state, twin, fo, job.only);
+  const FrictionRunSpec best{three_digits(fit.mu_s), job.seed, three_digits(fit.mu_r)};
+  const Comparison compared = compare_at_fit(job, best);
+  if (!mpi_ranks().root()) return;
+  const double true_s = true_friction(job.experiment.header(), "mu-s");
+  const double true_r = true_friction(job.experiment.header(), "mu-r");
+  std::vector<double> run_s, run_r;
+  for (const FrictionRunSpec& r : job.specs) {
+    run_s.push_back(r.mu_s);
+    run_r.push_back(r.mu_r);
+  }
+  char title[200];
+  std::snprintf(title, sizeof title,
+                "joint fit: mu_s = %.3g (%.3g-%.3g), mu_r = %.3g (%.3g-%.3g), correlation %.2f",
+                fit.mu_s, fit.mu_s_ci95[0], fit.mu_s_ci95[1], fit.mu_r, fit.mu_r_ci95[0],
+                fit.mu_r_ci95[1], fit.correlation);
+  const auto figure = plot_joint_region(job.out, "joint_fit", run_s, run_r, fit.region95,
+                                        {fit.mu_s, fit.mu_r}, {true_s, true_r}, title);
+  const std::size_t simulations = simulations_with(job, best);
+  std::ostringstream fitted, observables;
+  fitted << "  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
+         << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
+         << "],\n  \"mu_r\": " << json_number(fit.mu_r) << ",\n  \"mu_r_ci95\": ["
+         << json_number(fit.mu_r_ci95[0]) << ", " << json_number(fit.mu_r_ci95[1])
+         << "],\n  \"correlation\": " << json_number(fit.correlation)
+         << ",\n  \"log_covariance\": [" << json_number(fit.log_covariance[0]) << ", "
+         << json_number(fit.log_covariance[1]) << ", " << json_number(fit.log_covariance[2]) << ", "
+         << json_number(fit.log_covariance[3]) << "],\n  \"mu_s_true\": " << json_number(true_s)
+         << ",\n  \"mu_r_true\": " << json_number(true_r)
+         << ",\n  \"interval_method\": " << json_text(fit.method)
+         << ",\n  \"chi2\": " << json_number(fit.chi2) << ",\n  \"dof\": " << json_number(fit.dof)
+         << ",\n  \"region95\": [";
+  for (std::size_t k = 0; k < fit.region95.size(); ++k)
+    fitted << (k ? ", " : "") << "[" << json_number(fit.region95[k][0]) << ", "
+           << json_number(fit.region95[k][1]) << "]";
+  fitted << "]";
+  observables << "[";
+  for (std::size_t k = 0; k < fit.names.size(); ++k)
+    observables << (k ? ", " : "") << json_text(fit.names[k]);
+  observables << "]";
+  write_steady_state_summary(job, fitted.str(), observables.str(), simulations);
+  std::cout << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval "
+            << fit.mu_s_ci95[0] << " - " << fit.mu_s_ci95[1] << ")";
+  if (std::isfinite(true_s)) std::cout << "  true " << true_s;
+  std::cout << "\nmu_r = " << fit.mu_r << "  (95% interval " << fit.mu_r_ci95[0] << " - "
+            << fit.mu_r_ci95[1] << ")";
+  if (std::isfinite(true_r)) std::cout << "  true " << true_r;
+  std::cout << "\n  correlation of ln mu_s and ln mu_r " << fit.correlation << ", " << simulations
+            << " simulations\n";
+  print_observables(fit.names, nullptr, job);
+  std::cout << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; cross-validated "
+            << fit.cross_validated_sigma[0] << " (mu_s), " << fit.cross_validated_sigma[1]
+            << " (mu_r) in ln on " << fit.cross_validations << " runs\n"
+            << "wrote " << (job.out / "summary.json").string() << ", "
+            << figure.size() + compared.written.size() << " figure files\n";
+}
+
 }  // namespace
 
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
     std::string experiment, out, mu_s = "0.03,0.05,0.08,0.12,0.2,0.3,0.5", window, noise = "auto",
                                  wall_distance = "0", preparation = "each", summaries = "pooled",
-                                 observables = "displacements", only;
+                                 observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool keep_drift = false, fit_only = false;
     int threads = 0, degree = 2, replicas = 2;
@@ -253,6 +423,12 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "steady-state: fit only these observables, comma list (rot_disp, "
                   "bulk_packing_fraction, coordination, packing_fraction, "
                   "wall_force_full_compression); default all the experiment has");
+  cmd->add_option("--fit", args->fit,
+                  "the frictions fitted: mu_s, or mu_s,mu_r jointly (steady-state observables; "
+                  "--mu-r is then the list of rolling frictions simulated, e.g. "
+                  "0.003,0.01,0.03, and the twin every --mu-s x --mu-r)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mu_s", "mu_s,mu_r"}));
   cmd->add_flag("--fit-only", args->fit_only,
                 "steady-state: fit and stop; no run at the fitted friction, so no distances "
                 "or comparison figures (one simulation fewer)");
@@ -278,8 +454,19 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     for (const auto& [name, option] : given) {
       if (option->count() > 0) v[name] = args->twin.at(name);
     }
-    const std::vector<double> mu = parse_frictions(args->mu_s);
-    const std::size_t needed = std::size_t(args->degree) + (args->replicas > 1 ? 1 : 2);
+    const std::vector<double> mu = parse_frictions(args->mu_s, "--mu-s");
+    const bool joint = args->fit == "mu_s,mu_r";
+    std::vector<double> mu_r;
+    if (joint) {
+      mu_r = parse_frictions(v.at("mu-r"), "--mu-r");
+      v["mu-r"] = json_number(mu_r.front());  // each run sets its own
+    }
+    if (joint && args->observables != "steady-state") {
+      throw Error("--fit mu_s,mu_r: the joint fit is on --observables steady-state");
+    }
+    if (joint && mu_r.size() < 3) throw Error("--mu-r: the joint fit needs at least 3 values");
+    // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
+    const std::size_t needed = std::size_t(args->degree) + (joint || args->replicas > 1 ? 1 : 2);
     if (mu.size() < needed) {
       throw Error("--mu-s: " + std::to_string(mu.size()) + " frictions; the fit needs at least " +
                   std::to_string(needed) + " (degree " + std::to_string(args->degree) + " + 1" +
@@ -319,6 +506,17 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       return cycle_observables(experiment, o);
     }();
 
+    if (args->observables == "steady-state") {  // before the twin runs: names the fit can use
+      const SteadyState e = steady_state(experiment, measured);
+      for (const std::string& name : parse_names(args->only)) {
+        if (std::isfinite(e[name])) continue;
+        std::string has;
+        for (std::size_t k = 0; k < e.names.size(); ++k)
+          if (std::isfinite(e.values[k])) has += (has.empty() ? "" : ", ") + e.names[k];
+        throw Error("--only: '" + name + "' is not measured in " + args->experiment + " (it has " +
+                    has + ")");
+      }
+    }
     FrictionFitOptions fit_options;
     fit_options.degree = args->degree;
     fit_options.per_cycle = args->summaries == "per-cycle";
@@ -345,6 +543,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     FrictionSeriesOptions series;
     series.dir = out / "runs";
     series.walls_follow = wall_friction_follows(v);
+    if (joint && series.walls_follow != (v.at("wall-mu-r") == "same")) {
+      throw Error(
+          "--fit mu_s,mu_r: give the walls' sliding and rolling frictions alike (both "
+          "'same', following the grains', or both fixed)");
+    }
     series.parallel = args->threads;
     series.protocol.cycles = observe.window.second;
     series.protocol.drive = drive_from(v, physics, d.box_side, d.box_side, d.lid_mass, d.radius);
@@ -396,7 +599,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     }
     auto start = [&](const FrictionRunSpec& run) {
       if (args->preparation == "shared") {
-        return with_sliding_friction(shared.at(run.seed), run.mu_s, series.walls_follow);
+        return with_frictions(shared.at(run.seed), run, series.walls_follow);
       }
       return deposit_at_friction(d, physics, run, series.walls_follow);
     };
@@ -420,77 +623,30 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                         : int(std::thread::hardware_concurrency()))
                 << " at once\n";
       run_friction_series(todo, series, start, [&](std::size_t k, const CyclicProgress& p) {
-        std::cerr << "mu_s " << todo[k].mu_s << " seed " << todo[k].seed << ": cycle " << p.cycle
-                  << "/" << p.cycles << "  " << std::scientific << std::setprecision(2)
-                  << p.particle_steps_per_second << std::defaultfloat << std::setprecision(6)
-                  << " particle-steps/s  " << std::llround(p.seconds_left) << " s left\n";
+        std::cerr << "mu_s " << todo[k].mu_s
+                  << (todo[k].mu_r >= 0 ? " mu_r " + json_number(todo[k].mu_r) : std::string())
+                  << " seed " << todo[k].seed << ": cycle " << p.cycle << "/" << p.cycles << "  "
+                  << std::scientific << std::setprecision(2) << p.particle_steps_per_second
+                  << std::defaultfloat << std::setprecision(6) << " particle-steps/s  "
+                  << std::llround(p.seconds_left) << " s left\n";
       });
     };
     std::vector<FrictionRunSpec> specs;
     for (std::uint64_t seed : seeds)
       for (double m : mu)
-        specs.push_back({m, seed});
+        for (double r : joint ? mu_r : std::vector<double>{-1})
+          specs.push_back({m, seed, r});
     run_all(specs);
     if (args->observables == "steady-state") {
-      std::vector<SteadyStateRun> twin;
-      for (const FrictionRunSpec& run : specs) {
-        const TrajectoryReader r(friction_run_path(series.dir, run));
-        twin.push_back({run.mu_s, run.seed, steady_state(r, cycle_observables(r, observe))});
+      SteadyStateJob job{experiment,     args->experiment, measured,     observe,
+                         specs,          series.dir,       out,          v,
+                         d.seed,         args->replicas,   args->degree, parse_names(args->only),
+                         args->fit_only, run_all};
+      if (joint) {
+        fit_joint(job);
+      } else {
+        fit_steady_state(job);
       }
-      ObservableFitOptions fo;
-      fo.degree = args->degree;
-      const SteadyState exp_state = steady_state(experiment, measured);
-      const ObservableFit fit =
-          fit_friction_to_steady_state(exp_state, twin, fo, parse_names(args->only));
-      const FrictionRunSpec best_spec{three_digits(fit.mu_s), d.seed};
-      Comparison compared;
-      if (!args->fit_only) {
-        run_all({best_spec});
-        if (!mpi_ranks().root()) return;
-        compared = compare_runs(
-            experiment, TrajectoryReader(friction_run_path(series.dir, best_spec)), "experiment",
-            "DEM mu_s = " + json_number(best_spec.mu_s), observe, Eigen::Vector3d::Zero(), 0, out);
-      } else if (!mpi_ranks().root()) {
-        return;
-      }
-      const double truth = true_friction(h);
-      SteadyStateOutputs written = write_steady_state_fit(out, fit, exp_state, twin, truth);
-      const std::size_t simulations =
-          specs.size() +
-          (args->fit_only || std::count(mu.begin(), mu.end(), best_spec.mu_s) ? 0 : 1);
-      {
-        AtomicFile f(out / "summary.json");
-        std::ofstream j(f.temp_path());
-        j << "{\n  \"mu_s\": " << json_number(fit.mu_s) << ",\n  \"mu_s_ci95\": ["
-          << json_number(fit.mu_s_ci95[0]) << ", " << json_number(fit.mu_s_ci95[1])
-          << "],\n  \"mu_s_true\": " << json_number(truth)
-          << ",\n  \"mu_s_interval_method\": " << json_text(fit.method)
-          << ",\n  \"log_mu_s_sigma\": " << json_number(fit.log_mu_s_sigma)
-          << ",\n  \"gls_sigma\": " << json_number(fit.gls_sigma)
-          << ",\n  \"cross_validated_sigma\": " << json_number(fit.cross_validated_sigma)
-          << ",\n  \"chi2\": " << json_number(fit.chi2) << ",\n  \"dof\": " << json_number(fit.dof)
-          << ",\n  \"n_simulations\": " << simulations << ",\n  \"replicas\": " << args->replicas
-          << ",\n  \"observables\": " << written.json << ",\n  \"window\": ["
-          << observe.window.first << ", " << observe.window.second
-          << "],\n  \"experiment\": " << json_text(args->experiment)
-          << ",\n  \"settings\": " << settings_json(v) << "\n}\n";
-        j.close();
-        f.commit();
-      }
-      std::cout << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval "
-                << fit.mu_s_ci95[0] << " - " << fit.mu_s_ci95[1] << ", " << simulations
-                << " simulations)";
-      if (std::isfinite(truth)) std::cout << "  true " << truth;
-      std::cout << "\n  steady state over cycles " << observe.window.first << "-"
-                << observe.window.second << ":";
-      for (std::size_t k = 0; k < fit.names.size(); ++k)
-        std::cout << (k ? ", " : " ") << fit.names[k] << " (+-" << fit.resolution[k]
-                  << " in ln mu_s)";
-      std::cout << "\n  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
-                << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
-                << " in ln mu_s on " << fit.cross_validations << " runs\n"
-                << "wrote " << (out / "summary.json").string() << ", steady_state_runs.csv, "
-                << written.written.size() + compared.written.size() << " figure files\n";
       return;
     }
     std::vector<FrictionRun> runs;

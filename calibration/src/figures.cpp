@@ -80,6 +80,16 @@ std::vector<fs::path> draw(const fs::path& dir, const std::string& name, const s
   return written;
 }
 
+// Log axes spanning about a decade get too few tics: the design's own values instead.
+std::string design_tics(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  std::ostringstream t;
+  for (std::size_t k = 0; k < v.size(); ++k)
+    t << (k ? ", " : "(") << "\"" << v[k] << "\" " << v[k];
+  return t.str() + ")";
+}
+
 }  // namespace
 
 std::vector<fs::path> plot_log_pdfs(const fs::path& dir, const std::string& name,
@@ -228,7 +238,8 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
   data.precision(8);
   plot << "set multiplot layout " << rows << "," << columns << " title " << quoted(title)
        << "\nset logscale x\nset xlabel \"mu_s\"\nset key off\nset grid\n"
-       << "set xrange [" << lowest / 1.25 << ":" << highest * 1.25 << "]\n"
+       << "set xrange [" << lowest / 1.25 << ":" << highest * 1.25 << "]\nset xtics "
+       << design_tics(panels.front().run_mu_s) << "\n"
        << "set object 1 rect from " << ci95[0] << ", graph 0 to " << ci95[1]
        << ", graph 1 behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
        << "set arrow 1 from " << mu_s << ", graph 0 to " << mu_s
@@ -271,6 +282,53 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
   plot << "unset multiplot\n";
   const std::string size = std::to_string(420 * columns) + "," + std::to_string(330 * rows + 60);
   return draw(dir, name, data.str(), plot.str(), size);
+}
+
+std::vector<fs::path> plot_joint_region(const fs::path& dir, const std::string& name,
+                                        const std::vector<double>& run_x,
+                                        const std::vector<double>& run_y,
+                                        const std::vector<std::array<double, 2>>& region,
+                                        std::array<double, 2> fit, std::array<double, 2> truth,
+                                        const std::string& title) {
+  std::ostringstream data, plot;
+  data.precision(8);
+  data << "# twin runs: mu_s mu_r\n";
+  for (std::size_t k = 0; k < run_x.size(); ++k)
+    data << run_x[k] << " " << run_y[k] << "\n";
+  data << "\n\n# joint 95 % region: mu_s mu_r\n";
+  for (const auto& p : region)
+    data << p[0] << " " << p[1] << "\n";
+  data << "\n\n# fit\n" << fit[0] << " " << fit[1] << "\n\n\n# truth\n";
+  if (std::isfinite(truth[0]) && std::isfinite(truth[1])) data << truth[0] << " " << truth[1];
+  data << "\n";
+  std::array<double, 2> lo{fit[0], fit[1]}, hi = lo;
+  auto extend = [&](double x, double y) {
+    lo = {std::min(lo[0], x), std::min(lo[1], y)};
+    hi = {std::max(hi[0], x), std::max(hi[1], y)};
+  };
+  for (std::size_t k = 0; k < run_x.size(); ++k)
+    extend(run_x[k], run_y[k]);
+  for (const auto& p : region)
+    extend(p[0], p[1]);
+  const std::string file = quoted(name + ".dat");
+  plot << "set xtics " << design_tics(run_x) << "\nset ytics " << design_tics(run_y)
+       << "\nset title " << quoted(title)
+       << "\nset logscale xy\nset xlabel \"sliding friction mu_s\""
+       << "\nset ylabel \"rolling friction mu_r\"\nset key outside bottom center horizontal\n"
+       << "set xrange [" << lo[0] / 1.4 << ":" << hi[0] * 1.4 << "]\nset yrange [" << lo[1] / 1.4
+       << ":" << hi[1] * 1.4 << "]\n"
+       << "plot " << file
+       << " index 1 using 1:2 with filledcurves closed fc rgb \"#f4a582\" fs solid 0.45 "
+          "title \"joint 95 % region\", "
+       << file
+       << " index 0 using 1:2 with points pt 6 ps 1.5 lc rgb \"#404040\" title \"twin runs\", "
+       << file << " index 2 using 1:2 with points pt 7 ps 1.8 lc rgb \"#b2182b\" title \"fit\"";
+  if (std::isfinite(truth[0]) && std::isfinite(truth[1])) {
+    plot << ", " << file << " index 3 using 1:2 with points pt 3 ps 2.2 lw 2 lc rgb \"black\" "
+         << "title \"true\"";
+  }
+  plot << "\n";
+  return draw(dir, name, data.str(), plot.str(), "800,650");
 }
 
 }  // namespace granmem

@@ -8,15 +8,21 @@
 
 namespace granmem {
 
-PhysicsOptions with_sliding_friction(PhysicsOptions physics, double mu_s, bool walls_follow) {
-  physics.contact.mu_s = mu_s;
-  if (walls_follow) physics.wall.mu_s = mu_s;
+PhysicsOptions with_frictions(PhysicsOptions physics, const FrictionRunSpec& run,
+                              bool walls_follow) {
+  physics.contact.mu_s = run.mu_s;
+  if (walls_follow) physics.wall.mu_s = run.mu_s;
+  if (run.mu_r >= 0) {
+    physics.contact.mu_r = run.mu_r;
+    if (walls_follow) physics.wall.mu_r = run.mu_r;
+  }
   return physics;
 }
 
-Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool walls_follow) {
+Simulation with_frictions(const Simulation& packing, const FrictionRunSpec& run,
+                          bool walls_follow) {
   Simulation sim(packing.grains(), packing.container(),
-                 with_sliding_friction(packing.physics(), mu_s, walls_follow));
+                 with_frictions(packing.physics(), run, walls_follow));
   sim.restore(packing.time(), packing.step_count(), packing.pair_histories(),
               packing.wall_histories(), packing.wall_loads());
   return sim;
@@ -25,14 +31,19 @@ Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool wa
 Simulation deposit_at_friction(DepositOptions deposit, const PhysicsOptions& physics,
                                const FrictionRunSpec& run, bool walls_follow) {
   deposit.seed = run.seed;
-  return granmem::deposit(deposit, with_sliding_friction(physics, run.mu_s, walls_follow));
+  return granmem::deposit(deposit, with_frictions(physics, run, walls_follow));
 }
 
 std::filesystem::path friction_run_path(const std::filesystem::path& dir,
                                         const FrictionRunSpec& run) {
-  char name[96];
-  std::snprintf(name, sizeof name, "mu_s_%.4g_seed_%llu.h5", run.mu_s,
-                static_cast<unsigned long long>(run.seed));
+  char name[128];
+  if (run.mu_r >= 0) {
+    std::snprintf(name, sizeof name, "mu_s_%.4g_mu_r_%.4g_seed_%llu.h5", run.mu_s, run.mu_r,
+                  static_cast<unsigned long long>(run.seed));
+  } else {
+    std::snprintf(name, sizeof name, "mu_s_%.4g_seed_%llu.h5", run.mu_s,
+                  static_cast<unsigned long long>(run.seed));
+  }
   return dir / name;
 }
 
@@ -58,6 +69,7 @@ std::vector<std::filesystem::path> run_friction_series(
     c.checkpoint.clear();
     c.parameters["calibrate/mu_s"] = std::to_string(runs[k].mu_s);
     c.parameters["calibrate/seed"] = std::to_string(runs[k].seed);
+    if (runs[k].mu_r >= 0) c.parameters["calibrate/mu_r"] = std::to_string(runs[k].mu_r);
     ProtocolState state;
     run_cycles(sim, c, state, [&](const CyclicProgress& p) {
       if (!progress) return;

@@ -15,53 +15,81 @@
 namespace granmem {
 namespace {
 
-// The observables across the runs: a polynomial in x = ln(mu_s) - centre per observable,
-// and the covariance of one run's values about it.
+// The fitted log frictions: (ln mu_s) or (ln mu_s, ln mu_r).
+using LogFriction = Eigen::VectorXd;
+
+LogFriction log_friction(const ObservableRun& run, int dims) {
+  LogFriction x(dims);
+  x(0) = std::log(run.mu_s);
+  if (dims == 2) x(1) = std::log(run.mu_r);
+  return x;
+}
+
+// The exponents of a polynomial of total degree `degree` in `dims` variables.
+std::vector<std::array<int, 2>> polynomial_terms(int dims, int degree) {
+  std::vector<std::array<int, 2>> terms;
+  for (int total = 0; total <= degree; ++total)
+    for (int a = total; a >= 0; --a)
+      if (dims == 2 || a == total) terms.push_back({a, total - a});
+  return terms;
+}
+
+// The observables across the runs: a polynomial in x = log frictions - centre per
+// observable, and the covariance of one run's values about it.
 struct Trend {
-  double centre = 0;
-  int degree = 2;
-  Eigen::MatrixXd coefficients;    // (degree + 1) x observables
+  LogFriction centre;
+  std::vector<std::array<int, 2>> terms;
+  Eigen::MatrixXd coefficients;    // terms x observables
   Eigen::MatrixXd normal_inverse;  // (X^T X)^-1
   Eigen::MatrixXd covariance;      // observables x observables
   Eigen::VectorXd scatter;         // its diagonal's square roots, before shrinking
-  double spare = 0;                // runs - coefficients
+  double spare = 0;                // runs - terms
 
-  Eigen::RowVectorXd powers(double x) const {
-    Eigen::RowVectorXd p(degree + 1);
-    for (int k = 0; k <= degree; ++k)
-      p(k) = std::pow(x, k);
+  Eigen::RowVectorXd powers(const LogFriction& x) const {
+    Eigen::RowVectorXd p(Eigen::Index(terms.size()));
+    for (std::size_t t = 0; t < terms.size(); ++t) {
+      p(Eigen::Index(t)) = 1;
+      for (Eigen::Index d = 0; d < x.size(); ++d)
+        p(Eigen::Index(t)) *= std::pow(x(d) - centre(d), terms[t][std::size_t(d)]);
+    }
     return p;
   }
-  Eigen::VectorXd predict(double log_mu) const {
-    return (powers(log_mu - centre) * coefficients).transpose();
+  Eigen::VectorXd predict(const LogFriction& x) const {
+    return (powers(x) * coefficients).transpose();
   }
-  Eigen::VectorXd slope(double log_mu) const {
-    Eigen::RowVectorXd d = Eigen::RowVectorXd::Zero(degree + 1);
-    for (int k = 1; k <= degree; ++k)
-      d(k) = k * std::pow(log_mu - centre, k - 1);
+  // d(prediction) / d(ln mu_s)
+  Eigen::VectorXd slope(const LogFriction& x) const {
+    Eigen::RowVectorXd d = Eigen::RowVectorXd::Zero(Eigen::Index(terms.size()));
+    for (std::size_t t = 0; t < terms.size(); ++t) {
+      if (terms[t][0] == 0) continue;
+      double v = terms[t][0] * std::pow(x(0) - centre(0), terms[t][0] - 1);
+      if (x.size() == 2) v *= std::pow(x(1) - centre(1), terms[t][1]);
+      d(Eigen::Index(t)) = v;
+    }
     return (d * coefficients).transpose();
   }
   // Variance of the trend's prediction over one run's.
-  double leverage(double log_mu) const {
-    const Eigen::RowVectorXd p = powers(log_mu - centre);
+  double leverage(const LogFriction& x) const {
+    const Eigen::RowVectorXd p = powers(x);
     return (p * normal_inverse * p.transpose())(0, 0);
   }
 };
 
-Trend fit_trend(const std::vector<ObservableRun>& runs, int degree) {
+Trend fit_trend(const std::vector<ObservableRun>& runs, int dims, int degree) {
   Trend t;
-  t.degree = degree;
+  t.terms = polynomial_terms(dims, degree);
   const Eigen::Index k = Eigen::Index(runs.size()), m = Eigen::Index(runs.front().values.size());
+  t.centre = LogFriction::Zero(dims);
   for (const ObservableRun& r : runs)
-    t.centre += std::log(r.mu_s) / double(k);
-  Eigen::MatrixXd x(k, degree + 1), y(k, m);
+    t.centre += log_friction(r, dims) / double(k);
+  Eigen::MatrixXd x(k, Eigen::Index(t.terms.size())), y(k, m);
   for (Eigen::Index i = 0; i < k; ++i) {
-    x.row(i) = t.powers(std::log(runs[std::size_t(i)].mu_s) - t.centre);
+    x.row(i) = t.powers(log_friction(runs[std::size_t(i)], dims));
     y.row(i) = Eigen::Map<const Eigen::RowVectorXd>(runs[std::size_t(i)].values.data(), m);
   }
   t.normal_inverse = (x.transpose() * x).inverse();
   t.coefficients = t.normal_inverse * x.transpose() * y;
-  t.spare = double(k - (degree + 1));
+  t.spare = double(k) - double(t.terms.size());
   const Eigen::MatrixXd residual = y - x * t.coefficients;
   const Eigen::MatrixXd sample = residual.transpose() * residual / t.spare;
   t.scatter = sample.diagonal().cwiseSqrt();
@@ -78,87 +106,139 @@ struct Misfit {
   const Trend* trend;
   Eigen::VectorXd target;
   Eigen::MatrixXd whitening;
+  int dims;
   bool operator()(double const* const* p, double* r) const {
-    Eigen::Map<Eigen::VectorXd>(r, target.size()) = whitening * (trend->predict(p[0][0]) - target);
+    LogFriction x(dims);
+    for (int d = 0; d < dims; ++d)
+      x(d) = p[d][0];
+    Eigen::Map<Eigen::VectorXd>(r, target.size()) = whitening * (trend->predict(x) - target);
     return true;
   }
 };
 
-// C = (1 + leverage) Sigma at ln(mu_s): the experiment's realization and the trend's error.
-Eigen::MatrixXd whitening_at(const Trend& t, double log_mu) {
-  const Eigen::MatrixXd c = (1 + t.leverage(log_mu)) * t.covariance;
+// C = (1 + leverage) Sigma at x: the experiment's realization and the trend's error.
+Eigen::MatrixXd whitening_at(const Trend& t, const LogFriction& x) {
+  const Eigen::MatrixXd c = (1 + t.leverage(x)) * t.covariance;
   return c.llt().matrixL().solve(Eigen::MatrixXd::Identity(c.rows(), c.cols()));
 }
 
 struct OneFit {
-  double log_mu = 0, sigma = 0, chi2 = 0;
+  LogFriction x;
+  Eigen::MatrixXd covariance;  // of x, from Ceres
+  double chi2 = 0;
   Trend trend;
 };
 
-OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>& runs, int degree) {
-  OneFit f;
-  f.trend = fit_trend(runs, degree);
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+std::pair<LogFriction, LogFriction> bounds(const std::vector<ObservableRun>& runs, int dims) {
+  LogFriction lo = LogFriction::Constant(dims, std::numeric_limits<double>::infinity());
+  LogFriction hi = -lo;
   for (const ObservableRun& r : runs) {
-    lo = std::min(lo, std::log(r.mu_s));
-    hi = std::max(hi, std::log(r.mu_s));
+    lo = lo.cwiseMin(log_friction(r, dims));
+    hi = hi.cwiseMax(log_friction(r, dims));
   }
+  return {lo, hi};
+}
+
+OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>& runs, int dims,
+                int degree) {
+  OneFit f;
+  f.trend = fit_trend(runs, dims, degree);
+  const auto [lo, hi] = bounds(runs, dims);
   // Start from the best of a grid: the misfit need not be convex across the range.
+  const int n = dims == 1 ? 48 : 16;
   double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k <= 48; ++k) {
-    const double x = lo + (hi - lo) * k / 48.0;
-    const double c = (whitening_at(f.trend, x) * (f.trend.predict(x) - target)).squaredNorm();
-    if (c < best) {
-      best = c;
-      f.log_mu = x;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= (dims == 2 ? n : 0); ++j) {
+      LogFriction x = lo + (hi - lo) * (double(i) / n);
+      if (dims == 2) x(1) = lo(1) + (hi(1) - lo(1)) * j / n;
+      const double c = (whitening_at(f.trend, x) * (f.trend.predict(x) - target)).squaredNorm();
+      if (c < best) {
+        best = c;
+        f.x = x;
+      }
     }
   }
-  // Two rounds: the whitening depends on ln(mu_s) through the trend's leverage.
+  // Two rounds: the whitening depends on the frictions through the trend's leverage.
+  std::vector<double> p(f.x.data(), f.x.data() + dims);
   for (int round = 0; round < 2; ++round) {
     ceres::Problem problem;
     auto* cost = new ceres::DynamicNumericDiffCostFunction<Misfit, ceres::CENTRAL>(
-        new Misfit{&f.trend, target, whitening_at(f.trend, f.log_mu)});
-    cost->AddParameterBlock(1);
+        new Misfit{&f.trend, target, whitening_at(f.trend, f.x), dims});
+    std::vector<double*> blocks;
+    for (int d = 0; d < dims; ++d) {
+      cost->AddParameterBlock(1);
+      blocks.push_back(&p[std::size_t(d)]);
+    }
     cost->SetNumResiduals(int(target.size()));
-    problem.AddResidualBlock(cost, nullptr, &f.log_mu);
-    problem.SetParameterLowerBound(&f.log_mu, 0, lo);
-    problem.SetParameterUpperBound(&f.log_mu, 0, hi);
+    problem.AddResidualBlock(cost, nullptr, blocks);
+    for (int d = 0; d < dims; ++d) {
+      problem.SetParameterLowerBound(blocks[std::size_t(d)], 0, lo(d));
+      problem.SetParameterUpperBound(blocks[std::size_t(d)], 0, hi(d));
+    }
     ceres::Solver::Options so;
     so.max_num_iterations = 100;
     ceres::Solver::Summary summary;
     ceres::Solve(so, &problem, &summary);
     f.chi2 = 2 * summary.final_cost;
-    if (round == 1) {
-      f.sigma = std::sqrt(parameter_variances(problem, {&f.log_mu})[0]);
-    }
+    f.x = Eigen::Map<const LogFriction>(p.data(), dims);
+    if (round == 1) f.covariance = parameter_covariance(problem, blocks);
   }
   return f;
 }
 
 void check_runs(const std::vector<double>& experiment, const std::vector<ObservableRun>& runs,
-                int degree) {
+                int dims, int degree) {
   if (degree < 1) throw Error("observable fit: the polynomial degree must be at least 1");
-  if (experiment.empty()) throw Error("observable fit: no observable");
-  if (runs.size() < std::size_t(degree) + 2) {
-    throw Error("observable fit: " + std::to_string(runs.size()) + " runs, need at least " +
-                std::to_string(degree + 2) + " (a polynomial of degree " + std::to_string(degree) +
-                " in ln mu_s and one spare run for the scatter)");
+  if (experiment.size() < std::size_t(dims)) {
+    throw Error("observable fit: " + std::to_string(experiment.size()) + " observables for " +
+                std::to_string(dims) + " frictions");
   }
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  const std::size_t terms = polynomial_terms(dims, degree).size();
+  if (runs.size() < terms + 1) {
+    throw Error("observable fit: " + std::to_string(runs.size()) + " runs, need at least " +
+                std::to_string(terms + 1) + " (a polynomial of degree " + std::to_string(degree) +
+                " in the log frictions and one spare run for the scatter)");
+  }
   for (const ObservableRun& r : runs) {
-    if (!(r.mu_s > 0)) throw Error("observable fit: mu_s must be positive");
+    if (!(r.mu_s > 0) || (dims == 2 && !(r.mu_r > 0))) {
+      throw Error("observable fit: the frictions must be positive");
+    }
     if (r.values.size() != experiment.size()) {
       throw Error("observable fit: a run has " + std::to_string(r.values.size()) +
                   " observables, the experiment " + std::to_string(experiment.size()));
     }
     for (double v : r.values)
       if (!std::isfinite(v)) throw Error("observable fit: a run's observable is not finite");
-    lo = std::min(lo, r.mu_s);
-    hi = std::max(hi, r.mu_s);
   }
   for (double v : experiment)
     if (!std::isfinite(v)) throw Error("observable fit: an experiment's observable is not finite");
-  if (!(hi > lo)) throw Error("observable fit: the runs must differ in mu_s");
+  const auto [lo, hi] = bounds(runs, dims);
+  if (!(hi(0) > lo(0))) throw Error("observable fit: the runs must differ in mu_s");
+  if (dims == 2 && !(hi(1) > lo(1))) throw Error("observable fit: the runs must differ in mu_r");
+}
+
+// Cross-validation across packings: a run of known frictions fitted with the other seeds'
+// runs, at interior frictions (at the range's ends the bounded fit cannot err outwards).
+// Returns the RMS error of each log friction and the number of runs fitted.
+std::pair<LogFriction, std::size_t> cross_validate(const std::vector<ObservableRun>& runs, int dims,
+                                                   int degree) {
+  LogFriction sum2 = LogFriction::Zero(dims);
+  std::size_t count = 0;
+  for (const ObservableRun& held_out : runs) {
+    std::vector<ObservableRun> others;
+    for (const ObservableRun& r : runs)
+      if (r.seed != held_out.seed) others.push_back(r);
+    if (others.size() < polynomial_terms(dims, degree).size() + 1) continue;
+    const auto [lo, hi] = bounds(others, dims);
+    const LogFriction truth = log_friction(held_out, dims);
+    if (((truth - lo).array() <= 0).any() || ((hi - truth).array() <= 0).any()) continue;
+    const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(
+        held_out.values.data(), Eigen::Index(held_out.values.size()));
+    sum2 += (fit_once(v, others, dims, degree).x - truth).cwiseAbs2();
+    ++count;
+  }
+  if (count == 0) return {LogFriction::Zero(dims), 0};
+  return {(sum2 / double(count)).cwiseSqrt(), count};
 }
 
 constexpr int kCurvePoints = 60;
@@ -167,89 +247,12 @@ bool by_friction(const ObservableRun& a, const ObservableRun& b) {
   return a.mu_s < b.mu_s;
 }
 
-}  // namespace
-
-ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
-                                          const std::vector<ObservableRun>& runs,
-                                          const ObservableFitOptions& options) {
-  check_runs(experiment, runs, options.degree);
-  const Eigen::VectorXd target =
-      Eigen::Map<const Eigen::VectorXd>(experiment.data(), Eigen::Index(experiment.size()));
-  const OneFit f = fit_once(target, runs, options.degree);
-  ObservableFit fit;
-  fit.mu_s = std::exp(f.log_mu);
-  fit.chi2 = f.chi2;
-  fit.dof = double(experiment.size()) - 1;
-  fit.error_scale = fit.dof > 0 ? std::max(1.0, std::sqrt(fit.chi2 / fit.dof)) : 1.0;
-  fit.gls_sigma = f.sigma * fit.error_scale;
-  fit.log_mu_s_sigma = fit.gls_sigma;
-  double t = student_t_975(f.trend.spare);
-  fit.simulations = runs.size();
-  const Eigen::VectorXd model = f.trend.predict(f.log_mu), slope = f.trend.slope(f.log_mu);
-  const double inflation = std::sqrt(1 + f.trend.leverage(f.log_mu));
-  for (Eigen::Index o = 0; o < target.size(); ++o) {
-    fit.model.push_back(model(o));
-    fit.scatter.push_back(f.trend.scatter(o));
-    fit.resolution.push_back(inflation * f.trend.scatter(o) / std::abs(slope(o)));
-  }
-  fit.curve.resize(std::size_t(target.size()));
-  const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end(), by_friction);
-  for (int k = 0; k <= kCurvePoints; ++k) {
-    const double x = std::log(lo->mu_s) + std::log(hi->mu_s / lo->mu_s) * k / kCurvePoints;
-    fit.curve_mu_s.push_back(std::exp(x));
-    const Eigen::VectorXd y = f.trend.predict(x);
-    for (Eigen::Index o = 0; o < target.size(); ++o)
-      fit.curve[std::size_t(o)].push_back(y(o));
-  }
-
-  // Cross-validation across packings: a run of known friction fitted with the other
-  // seeds' runs, at interior frictions (at the range's ends the bounded fit cannot err
-  // outwards).
-  if (options.cross_validate) {
-    double sum2 = 0;
-    for (const ObservableRun& held_out : runs) {
-      std::vector<ObservableRun> others;
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const ObservableRun& r : runs) {
-        if (r.seed == held_out.seed) continue;
-        others.push_back(r);
-        lo = std::min(lo, r.mu_s);
-        hi = std::max(hi, r.mu_s);
-      }
-      if (others.size() < std::size_t(options.degree) + 2 ||
-          !(lo < held_out.mu_s && held_out.mu_s < hi)) {
-        continue;
-      }
-      const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(
-          held_out.values.data(), Eigen::Index(held_out.values.size()));
-      sum2 += std::pow(fit_once(v, others, options.degree).log_mu - std::log(held_out.mu_s), 2);
-      ++fit.cross_validations;
-    }
-    if (fit.cross_validations > 0) {
-      fit.cross_validated_sigma = std::sqrt(sum2 / double(fit.cross_validations));
-      if (fit.cross_validated_sigma > fit.log_mu_s_sigma) {
-        fit.log_mu_s_sigma = fit.cross_validated_sigma;
-        t = student_t_975(double(fit.cross_validations));
-      }
-    }
-  }
-  fit.mu_s_ci95 = {std::exp(f.log_mu - t * fit.log_mu_s_sigma),
-                   std::exp(f.log_mu + t * fit.log_mu_s_sigma)};
-  fit.method = "Ceres generalized least squares of " + std::to_string(experiment.size()) +
-               " steady-state observables against their trend in ln mu_s (degree " +
-               std::to_string(options.degree) + ") across " + std::to_string(runs.size()) +
-               " runs, covariance from the runs' scatter about it (" +
-               std::to_string(int(f.trend.spare)) + " spare runs, shrunk to its diagonal)" +
-               (fit.cross_validations > 0 ? "; cross-validated across packings on " +
-                                                std::to_string(fit.cross_validations) + " runs"
-                                          : std::string());
-  return fit;
-}
-
-ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
-                                           const std::vector<SteadyStateRun>& runs,
-                                           const ObservableFitOptions& options,
-                                           const std::vector<std::string>& only) {
+// The observables that the experiment and every run have (or `only`), as plain vectors.
+std::vector<std::string> common_observables(const SteadyState& experiment,
+                                            const std::vector<SteadyStateRun>& runs,
+                                            const std::vector<std::string>& only,
+                                            std::vector<double>& measured,
+                                            std::vector<ObservableRun>& twin) {
   std::vector<std::string> names;
   for (const std::string& name : only.empty() ? experiment.names : only) {
     const bool everywhere = std::isfinite(experiment[name]) &&
@@ -263,17 +266,173 @@ ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
     }
   }
   if (names.empty()) throw Error("observable fit: no observable in the experiment and every run");
-  std::vector<double> measured;
   for (const std::string& name : names)
     measured.push_back(experiment[name]);
-  std::vector<ObservableRun> twin;
   for (const SteadyStateRun& r : runs) {
-    ObservableRun run{r.mu_s, r.seed, {}};
+    ObservableRun run{r.mu_s, r.seed, {}, r.mu_r};
     for (const std::string& name : names)
       run.values.push_back(r.state[name]);
     twin.push_back(std::move(run));
   }
+  return names;
+}
+
+std::string method_text(std::size_t observables, const std::string& variables, int degree,
+                        std::size_t runs, double spare, std::size_t cross_validations) {
+  return "Ceres generalized least squares of " + std::to_string(observables) +
+         " steady-state observables against their trend in " + variables + " (degree " +
+         std::to_string(degree) + ") across " + std::to_string(runs) +
+         " runs, covariance from the runs' scatter about it (" + std::to_string(int(spare)) +
+         " spare runs, shrunk to its diagonal)" +
+         (cross_validations > 0 ? "; cross-validated across packings on " +
+                                      std::to_string(cross_validations) + " runs"
+                                : std::string());
+}
+
+// The GLS fit of `dims` log frictions with its misfit: chi2 over observables - dims dof,
+// and sqrt(chi2 / dof) when above 1, the factor the fit's errors are widened by.
+struct Misfitted {
+  Eigen::VectorXd target;
+  OneFit f;
+  double dof = 0, error_scale = 1;
+};
+Misfitted fit_checked(const std::vector<double>& experiment, const std::vector<ObservableRun>& runs,
+                      int dims, int degree) {
+  check_runs(experiment, runs, dims, degree);
+  Misfitted m;
+  m.target = Eigen::Map<const Eigen::VectorXd>(experiment.data(), Eigen::Index(experiment.size()));
+  m.f = fit_once(m.target, runs, dims, degree);
+  m.dof = double(experiment.size()) - dims;
+  m.error_scale = m.dof > 0 ? std::max(1.0, std::sqrt(m.f.chi2 / m.dof)) : 1.0;
+  return m;
+}
+
+}  // namespace
+
+ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
+                                          const std::vector<ObservableRun>& runs,
+                                          const ObservableFitOptions& options) {
+  const Misfitted m = fit_checked(experiment, runs, 1, options.degree);
+  const Eigen::VectorXd& target = m.target;
+  const OneFit& f = m.f;
+  ObservableFit fit;
+  fit.mu_s = std::exp(f.x(0));
+  fit.chi2 = f.chi2;
+  fit.dof = m.dof;
+  fit.error_scale = m.error_scale;
+  fit.gls_sigma = std::sqrt(f.covariance(0, 0)) * fit.error_scale;
+  fit.log_mu_s_sigma = fit.gls_sigma;
+  double t = student_t_975(f.trend.spare);
+  fit.simulations = runs.size();
+  const Eigen::VectorXd model = f.trend.predict(f.x), slope = f.trend.slope(f.x);
+  const double inflation = std::sqrt(1 + f.trend.leverage(f.x));
+  for (Eigen::Index o = 0; o < target.size(); ++o) {
+    fit.model.push_back(model(o));
+    fit.scatter.push_back(f.trend.scatter(o));
+    fit.resolution.push_back(inflation * f.trend.scatter(o) / std::abs(slope(o)));
+  }
+  fit.curve.resize(std::size_t(target.size()));
+  const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end(), by_friction);
+  for (int k = 0; k <= kCurvePoints; ++k) {
+    LogFriction x(1);
+    x(0) = std::log(lo->mu_s) + std::log(hi->mu_s / lo->mu_s) * k / kCurvePoints;
+    fit.curve_mu_s.push_back(std::exp(x(0)));
+    const Eigen::VectorXd y = f.trend.predict(x);
+    for (Eigen::Index o = 0; o < target.size(); ++o)
+      fit.curve[std::size_t(o)].push_back(y(o));
+  }
+  if (options.cross_validate) {
+    const auto [rms, count] = cross_validate(runs, 1, options.degree);
+    fit.cross_validations = count;
+    fit.cross_validated_sigma = rms(0);
+    if (count > 0 && fit.cross_validated_sigma > fit.log_mu_s_sigma) {
+      fit.log_mu_s_sigma = fit.cross_validated_sigma;
+      t = student_t_975(double(count));
+    }
+  }
+  fit.mu_s_ci95 = {std::exp(f.x(0) - t * fit.log_mu_s_sigma),
+                   std::exp(f.x(0) + t * fit.log_mu_s_sigma)};
+  fit.method = method_text(experiment.size(), "ln mu_s", options.degree, runs.size(), f.trend.spare,
+                           fit.cross_validations);
+  return fit;
+}
+
+ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
+                                           const std::vector<SteadyStateRun>& runs,
+                                           const ObservableFitOptions& options,
+                                           const std::vector<std::string>& only) {
+  std::vector<double> measured;
+  std::vector<ObservableRun> twin;
+  const std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
   ObservableFit fit = fit_friction_to_observables(measured, twin, options);
+  fit.names = names;
+  return fit;
+}
+
+JointObservableFit fit_frictions_to_observables(const std::vector<double>& experiment,
+                                                const std::vector<ObservableRun>& runs,
+                                                const ObservableFitOptions& options) {
+  const Misfitted m = fit_checked(experiment, runs, 2, options.degree);
+  const Eigen::VectorXd& target = m.target;
+  const OneFit& f = m.f;
+  JointObservableFit fit;
+  fit.mu_s = std::exp(f.x(0));
+  fit.mu_r = std::exp(f.x(1));
+  fit.chi2 = f.chi2;
+  fit.dof = m.dof;
+  fit.error_scale = m.error_scale;
+  Eigen::Matrix2d c = f.covariance * fit.error_scale * fit.error_scale;
+  fit.gls_sigma = {std::sqrt(c(0, 0)), std::sqrt(c(1, 1))};
+  double dof = f.trend.spare;
+  fit.simulations = runs.size();
+  const Eigen::VectorXd model = f.trend.predict(f.x);
+  for (Eigen::Index o = 0; o < target.size(); ++o) {
+    fit.model.push_back(model(o));
+    fit.scatter.push_back(f.trend.scatter(o));
+  }
+  // Each log friction's error is the larger of the fit's and the cross-validation's; the
+  // correlation is the fit's.
+  if (options.cross_validate) {
+    const auto [rms, count] = cross_validate(runs, 2, options.degree);
+    fit.cross_validations = count;
+    fit.cross_validated_sigma = {rms(0), rms(1)};
+    if (count > 0 && (rms(0) > fit.gls_sigma[0] || rms(1) > fit.gls_sigma[1])) {
+      Eigen::Matrix2d scale = Eigen::Matrix2d::Zero();
+      for (int d = 0; d < 2; ++d)
+        scale(d, d) = std::max(1.0, rms(d) / fit.gls_sigma[std::size_t(d)]);
+      c = scale * c * scale;
+      dof = double(count);
+    }
+  }
+  const double t = student_t_975(dof);
+  fit.log_covariance = {c(0, 0), c(0, 1), c(1, 0), c(1, 1)};
+  fit.correlation = c(0, 1) / std::sqrt(c(0, 0) * c(1, 1));
+  fit.mu_s_ci95 = {std::exp(f.x(0) - t * std::sqrt(c(0, 0))),
+                   std::exp(f.x(0) + t * std::sqrt(c(0, 0)))};
+  fit.mu_r_ci95 = {std::exp(f.x(1) - t * std::sqrt(c(1, 1))),
+                   std::exp(f.x(1) + t * std::sqrt(c(1, 1)))};
+  // chi-square with 2 dof at 95 %: -2 ln 0.05; Student's t's excess over the normal's 1.96
+  // for the finite dof behind the covariance.
+  const double radius = std::sqrt(-2 * std::log(0.05)) * t / 1.959964;
+  const Eigen::Matrix2d l = c.llt().matrixL();
+  for (int k = 0; k <= 72; ++k) {
+    const double a = 2 * M_PI * k / 72;
+    const Eigen::Vector2d x = f.x + radius * l * Eigen::Vector2d(std::cos(a), std::sin(a));
+    fit.region95.push_back({std::exp(x(0)), std::exp(x(1))});
+  }
+  fit.method = method_text(experiment.size(), "(ln mu_s, ln mu_r)", options.degree, runs.size(),
+                           f.trend.spare, fit.cross_validations);
+  return fit;
+}
+
+JointObservableFit fit_frictions_to_steady_state(const SteadyState& experiment,
+                                                 const std::vector<SteadyStateRun>& runs,
+                                                 const ObservableFitOptions& options,
+                                                 const std::vector<std::string>& only) {
+  std::vector<double> measured;
+  std::vector<ObservableRun> twin;
+  const std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
+  JointObservableFit fit = fit_frictions_to_observables(measured, twin, options);
   fit.names = names;
   return fit;
 }

@@ -79,4 +79,11 @@ std::vector<std::filesystem::path> plot_observable_fit(const std::filesystem::pa
                                                        double mu_s, std::array<double, 2> ci95,
                                                        double true_mu_s, const std::string& title);
 
+// A joint fit of two frictions: the twin's design points, the joint 95 % region's
+// boundary, the fit and, for a pseudo-experiment, the truth (NaN: unknown), log-log.
+std::vector<std::filesystem::path> plot_joint_region(
+    const std::filesystem::path& dir, const std::string& name, const std::vector<double>& run_x,
+    const std::vector<double>& run_y, const std::vector<std::array<double, 2>>& region,
+    std::array<double, 2> fit, std::array<double, 2> truth, const std::string& title);
+
 }  // namespace granmem

@@ -13,10 +13,12 @@
 namespace granmem {
 
 // One run of the simulated twin: its sliding friction and the seed of its packing (runs of
-// one seed pour the same grains; other seeds are other realizations of the packing).
+// one seed pour the same grains; other seeds are other realizations of the packing), and
+// its rolling friction where the twin varies it (< 0: the physics' own).
 struct FrictionRunSpec {
   double mu_s = 0;
   std::uint64_t seed = 1;
+  double mu_r = -1;
 };
 
 // The simulated twin of an experiment run at several sliding frictions and seeds, under the
@@ -24,16 +26,17 @@ struct FrictionRunSpec {
 struct FrictionSeriesOptions {
   CyclicOptions protocol;     // drive and cycles (its out and checkpoint are not used)
   std::filesystem::path dir;  // run k goes to friction_run_path(dir, mu_s, seed)
-  bool walls_follow = true;   // the walls' and lid's sliding friction is the grains'
+  bool walls_follow = true;   // the walls' and lid's frictions are the grains'
   int parallel = 0;           // runs at once, one thread each; 0: all cores
 };
 
-// The physics with another sliding friction between grains (and on the walls with
-// `walls_follow`).
-PhysicsOptions with_sliding_friction(PhysicsOptions physics, double mu_s, bool walls_follow);
+// The physics with the run's sliding (and rolling, where it sets one) friction between
+// grains, and on the walls with `walls_follow`.
+PhysicsOptions with_frictions(PhysicsOptions physics, const FrictionRunSpec& run,
+                              bool walls_follow);
 
-// The packing with another sliding friction, every contact's history kept.
-Simulation with_sliding_friction(const Simulation& packing, double mu_s, bool walls_follow);
+// The packing with the run's frictions, every contact's history kept.
+Simulation with_frictions(const Simulation& packing, const FrictionRunSpec& run, bool walls_follow);
 
 // The grains of `run.seed` poured and deposited at the run's friction: the experiment's
 // packing was prepared with its own friction, which sets how loose it is.

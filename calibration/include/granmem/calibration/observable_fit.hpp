@@ -12,11 +12,12 @@ namespace granmem {
 
 // One twin run: its sliding friction, its packing's seed, and the steady-state values of
 // the observables (window means: packing fraction, wall force, mean rotation, ...), in the
-// same order as the experiment's.
+// same order as the experiment's; its rolling friction where the fit is joint.
 struct ObservableRun {
   double mu_s = 0;
   std::uint64_t seed = 1;
   std::vector<double> values;
+  double mu_r = 0;
 };
 
 struct ObservableFitOptions {
@@ -67,6 +68,7 @@ struct SteadyStateRun {
   double mu_s = 0;
   std::uint64_t seed = 1;
   SteadyState state;
+  double mu_r = 0;
 };
 
 // The same fit on the observables that the experiment and every run have, by name, in the
@@ -77,5 +79,38 @@ ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
                                            const std::vector<SteadyStateRun>& runs,
                                            const ObservableFitOptions& options = {},
                                            const std::vector<std::string>& only = {});
+
+// The joint fit of the sliding and rolling frictions: the same model with each observable
+// a polynomial of total degree `degree` in (ln mu_s, ln mu_r) across runs that vary both
+// (e.g. a 3 x 3 grid per packing); Ceres fits both logs within the runs' ranges.
+struct JointObservableFit {
+  double mu_s = 0, mu_r = 0;
+  std::array<double, 2> mu_s_ci95{0, 0}, mu_r_ci95{0, 0};  // marginal 95 % intervals
+  // The covariance of (ln mu_s, ln mu_r) behind the intervals and the region, row-major.
+  std::array<double, 4> log_covariance{0, 0, 0, 0};
+  double correlation = 0;
+  // The joint 95 % confidence region's boundary, (mu_s, mu_r) points around it: the
+  // ellipse of the covariance in the logs at chi-square(2 dof) 95 %, scaled by Student's t
+  // for the dof the covariance rests on.
+  std::vector<std::array<double, 2>> region95;
+  double chi2 = 0, dof = 0;  // dof = observables - 2
+  double error_scale = 1;
+  std::array<double, 2> gls_sigma{0, 0}, cross_validated_sigma{0, 0};
+  std::size_t cross_validations = 0;
+  std::vector<double> scatter, model;
+  std::vector<std::string> names;
+  std::size_t simulations = 0;
+  std::string method;
+};
+
+// Throws Error for fewer runs than the polynomial's terms + 1, runs of one mu_s or one mu_r,
+// or fewer observables than 2.
+JointObservableFit fit_frictions_to_observables(const std::vector<double>& experiment,
+                                                const std::vector<ObservableRun>& runs,
+                                                const ObservableFitOptions& options = {});
+JointObservableFit fit_frictions_to_steady_state(const SteadyState& experiment,
+                                                 const std::vector<SteadyStateRun>& runs,
+                                                 const ObservableFitOptions& options = {},
+                                                 const std::vector<std::string>& only = {});
 
 }  // namespace granmem

@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# The steady-state friction fit measured on pseudo-experiments (docs/CALIBRATION.md, issue
+# 17): pseudo-experiments simulated by granmem at frictions the fit is not told, then
+# `granmem calibrate --observables steady-state` with one twin shared by all of them.
+# Reduced scale at the paper's lid pressure: 1,500 grains of 5 mm, 5 cm box, 436 Pa,
+# A = 1 %, 40 cycles, window 31:40 (the last 10, as the paper).
+#
+#   scripts/steady_state_calibration.sh [--out DIR] [--granmem BIN] [--mu-s LIST]
+#                                       [--replicas N] [--joint]
+#
+# Pseudo-experiments (mu_s, seed): (0.15, 7), (0.25, 8), (0.35, 9), (0.1, 10). The twin:
+# --mu-s (default 0.05,0.1,0.2,0.4) x --replicas packings (default 3: seeds 1-3) = 12
+# runs, in DIR/runs, reused by every fit and by a second call (stopped runs are redone).
+# --joint: also the joint mu_s / mu_r fit of the first pseudo-experiment (mu_r = 0.01) on
+# a 3 x 3 grid (mu_s 0.05,0.12,0.3 x mu_r 0.004,0.012,0.036) x 2 packings, in DIR/joint.
+# Writes DIR/fits.csv (one line per pseudo-experiment) and each fit's folder.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+out="$root/out/steady_state_calibration"
+granmem="$root/build/app/granmem"
+mus="0.05,0.1,0.2,0.4"
+replicas=3
+joint=0
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --out) out="$2"; shift ;;
+    --granmem) granmem="$2"; shift ;;
+    --mu-s) mus="$2"; shift ;;
+    --replicas) replicas="$2"; shift ;;
+    --joint) joint=1 ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    *) echo "steady_state_calibration.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+  shift
+done
+[[ -x $granmem ]] || { echo "steady_state_calibration.sh: no granmem at $granmem" >&2; exit 1; }
+mkdir -p "$out/runs"
+cd "$out"
+cat > protocol.toml <<'EOF'
+# 1,500 grains at the paper's lid pressure (the default 436 Pa), A = 1 %, 40 cycles
+[simulate]
+grains = "1500"
+box = "5cm"
+amplitude = "1%"
+cycles = "40"
+EOF
+
+pseudo() {  # name mu_s seed: simulated once, resumed from its checkpoint if stopped
+  local name=$1 mu=$2 seed=$3
+  [[ -e $name.done ]] && return 0
+  local args=(--mu-s "$mu" --seed "$seed" --checkpoint-every 5 --out "$name.h5"
+              --checkpoint "$name.checkpoint.h5")
+  [[ -s $name.checkpoint.h5 ]] && args=(--resume "$name.checkpoint.h5")
+  OMP_NUM_THREADS=1 "$granmem" --config protocol.toml simulate --threads 1 "${args[@]}" \
+    > "$name.log" 2>&1
+  touch "$name.done"
+}
+export -f pseudo
+export granmem
+printf '%s\n' "pseudo_0.15 0.15 7" "pseudo_0.25 0.25 8" "pseudo_0.35 0.35 9" "pseudo_0.1 0.1 10" |
+  xargs -P 2 -L 1 bash -c 'pseudo "$@"' _
+
+echo "experiment,mu_s_true,mu_s,ci95_low,ci95_high,n_simulations" > fits.csv.tmp
+for p in pseudo_0.15 pseudo_0.25 pseudo_0.35 pseudo_0.1; do
+  mkdir -p "fit_$p"
+  ln -sfn ../runs "fit_$p/runs"
+  "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "fit_$p" \
+    --mu-s "$mus" --replicas "$replicas" --observables steady-state --fit-only --threads 2 \
+    2> "fit_$p.log" | tee "fit_$p.txt"
+  awk -v p="$p" '/"mu_s":/ {gsub(/[,]/, ""); m = $2}
+    /"mu_s_ci95":/ {gsub(/[][,]/, " "); lo = $2; hi = $3}
+    /"mu_s_true":/ {gsub(/,/, ""); t = $2}
+    /"n_simulations":/ {gsub(/,/, ""); n = $2}
+    END {print p "," t "," m "," lo "," hi "," n}' "fit_$p/summary.json" >> fits.csv.tmp
+done
+mv fits.csv.tmp fits.csv
+cat fits.csv
+
+if [[ $joint -eq 1 ]]; then
+  "$granmem" --config protocol.toml calibrate --experiment pseudo_0.15.h5 --out joint \
+    --fit mu_s,mu_r --mu-s 0.05,0.12,0.3 --mu-r 0.004,0.012,0.036 --replicas 2 \
+    --observables steady-state --threads 2 2> joint.log | tee joint.txt
+fi

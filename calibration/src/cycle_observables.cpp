@@ -171,6 +171,7 @@ std::string steady_state_label(const std::string& name) {
       {"rot_disp", "rotational displacement (d)"},
       {"bulk_packing_fraction", "bulk packing fraction (positions)"},
       {"coordination", "coordination number (positions)"},
+      {"height_packing_fraction", "packing fraction (positions' height)"},
       {"packing_fraction", "packing fraction (lid height)"},
       {"wall_force_full_compression", "wall force at full compression (N)"}};
   const auto it = labels.find(name);
@@ -199,17 +200,25 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
     s.values.push_back(rot);
   }
   std::vector<std::int64_t> cycles;
-  std::vector<double> packing, coordination;
+  std::vector<double> packing, coordination, from_height;
+  // The container's cross-section, in the positions' unit (NaN: no box).
+  const auto& h = run.header();
+  const double section = h.box ? h.box->edges(0) * h.box->edges(1) : kNaN;
   for (std::size_t t = 0; t < run.frame_count(); ++t) {
     if (!in_window(run.steps()[t])) continue;
-    const PackingStructure p =
-        packing_structure(run.read_frame(t).position, run.header().radius, structure);
+    const Vectors3 position = run.read_frame(t).position;
+    const PackingStructure p = packing_structure(position, h.radius, structure);
     cycles.push_back(run.steps()[t]);
     packing.push_back(p.packing_fraction);
     coordination.push_back(p.coordination);
+    from_height.push_back(height_packing_fraction(position, h.radius, section));
   }
   s.names.insert(s.names.end(), {"bulk_packing_fraction", "coordination"});
   s.values.insert(s.values.end(), {mean_of(cycles, packing), mean_of(cycles, coordination)});
+  if (h.box) {
+    s.names.push_back("height_packing_fraction");
+    s.values.push_back(mean_of(cycles, from_height));
+  }
   for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
     const auto it = run.observables().find(name);
     if (it == run.observables().end()) continue;

@@ -254,7 +254,12 @@ std::vector<std::string> common_observables(const SteadyState& experiment,
                                             std::vector<double>& measured,
                                             std::vector<ObservableRun>& twin) {
   std::vector<std::string> names;
+  // By default the lid's packing fraction is left out where the positions' height gives
+  // the same number (both are the grains' volume under the lid): counted twice it would
+  // weigh twice.
+  const bool from_height = std::isfinite(experiment["height_packing_fraction"]);
   for (const std::string& name : only.empty() ? experiment.names : only) {
+    if (only.empty() && from_height && name == "packing_fraction") continue;
     const bool everywhere = std::isfinite(experiment[name]) &&
                             std::all_of(runs.begin(), runs.end(), [&](const SteadyStateRun& r) {
                               return std::isfinite(r.state[name]);

@@ -100,14 +100,15 @@ TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
   EXPECT_EQ(fit_line(again.out), fit_line(r.out));
 }
 
-// The steady-state fit: the pseudo-experiment's lid and wall force are used beside the
-// observables from positions, its true friction is reported, the figure drawn.
+// The steady-state fit: the pseudo-experiment's wall force is used beside the observables
+// from positions (the packing's height standing for its lid's), its true friction is
+// reported, the figure drawn.
 TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   const RunResult r = granmem_ok(calibrate({"--window", "2:3", "--mu-s", "0.05,0.1,0.2,0.4",
                                             "--observables", "steady-state", "--fit-only"}));
   EXPECT_NE(r.out.find("true 0.2"), std::string::npos) << r.out;
   const std::string json = read_text(in_work("cal/summary.json"));
-  for (const char* key : {"\"packing_fraction\"", "\"wall_force_full_compression\"",
+  for (const char* key : {"\"height_packing_fraction\"", "\"wall_force_full_compression\"",
                           "\"n_simulations\": 8", "\"settings\""}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << " in " << json;
   }

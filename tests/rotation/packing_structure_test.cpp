@@ -65,5 +65,21 @@ TEST(PackingStructure, NeighboursBeyondTheGapAndUnknownPositionsDoNotCount) {
       packing_structure(x, std::vector<double>(r.size(), std::nan(""))).packing_fraction));
 }
 
+// The whole packing from its height: a simple cubic stack of 10 x 10 x 10 unit cells
+// filling a 10 x 10 cross-section is pi/6 wherever it sits (no floor to register); a
+// grain not located leaves out its volume, 1/N of the fraction; a cubic stack twice as
+// tall in a cross-section twice as wide, in the same unit, is the same.
+TEST(PackingStructure, TheHeightPackingFractionOfACubicStackIsPiOverSix) {
+  Vectors3 x = lattice(10, 1.0, {Eigen::Vector3d::Zero()}, {0.5, 0.5, 31.7});
+  const std::vector<double> r(std::size_t(x.rows()), 0.5);
+  EXPECT_NEAR(height_packing_fraction(x, r, 100.0), M_PI / 6, 1e-12);
+  x.row(17).setConstant(std::nan(""));
+  EXPECT_NEAR(height_packing_fraction(x, r, 100.0), M_PI / 6 * 999 / 1000, 1e-12);
+  const Vectors3 big = lattice(10, 2.0, {Eigen::Vector3d::Zero()}, {0, 0, 0});
+  const std::vector<double> r_big(std::size_t(big.rows()), 1.0);
+  EXPECT_NEAR(height_packing_fraction(big, r_big, 400.0), M_PI / 6, 1e-12);
+  EXPECT_TRUE(std::isnan(height_packing_fraction(x, r, 0.0)));
+}
+
 }  // namespace
 }  // namespace granmem

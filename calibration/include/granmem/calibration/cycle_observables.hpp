@@ -77,6 +77,8 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
 //   rot_disp                     single-axis rotational displacement, diameters (axes)
 //   bulk_packing_fraction        from positions (packing_structure.hpp)
 //   coordination                 from positions
+//   height_packing_fraction      from positions: the whole packing's height and the
+//                                container's cross-section (the run's box; NaN without)
 //   packing_fraction             from the lid height (simulations; the store's)
 //   wall_force_full_compression  N (the store's)
 struct SteadyState {

@@ -72,9 +72,10 @@ struct SteadyStateRun {
 };
 
 // The same fit on the observables that the experiment and every run have, by name, in the
-// experiment's order (a scan has no lid height, a run without axes no rotations), or on
-// `only` where it is not empty (Error naming one that is missing). The fit's `names` says
-// which were used.
+// experiment's order (a scan has no lid height, a run without axes no rotations; the lid's
+// packing_fraction is left out where height_packing_fraction, the same from positions, is
+// there), or on `only` where it is not empty (Error naming one that is missing). The
+// fit's `names` says which were used.
 ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
                                            const std::vector<SteadyStateRun>& runs,
                                            const ObservableFitOptions& options = {},

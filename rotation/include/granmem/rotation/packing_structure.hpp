@@ -37,4 +37,13 @@ struct PackingStructure {
 PackingStructure packing_structure(const Vectors3& position, const std::vector<double>& radius,
                                    const StructureOptions& options = {});
 
+// The packing fraction of the whole packing from its height: the grains' volume over the
+// container's cross-section (`cross_section`, m^2 or the positions' unit squared) times
+// the height from the lowest grain's bottom to the highest grain's top, which is where
+// the floor and a free lid are. From positions alone, so a scan measures it as the DEM's
+// lid does, without registering the scan to the container's floor. NaN without grains
+// or cross-section.
+double height_packing_fraction(const Vectors3& position, const std::vector<double>& radius,
+                               double cross_section);
+
 }  // namespace granmem

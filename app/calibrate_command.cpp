@@ -107,7 +107,8 @@ double three_digits(double x) {
 // figure, and the summary's per-observable part.
 struct SteadyStateOutputs {
   std::vector<std::filesystem::path> written;
-  std::string json;  // the "observables" member of summary.json
+  std::vector<std::string> notes;  // observables that still drift across the window
+  std::string json;                // the "observables" member of summary.json
 };
 
 SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableFit& fit,
@@ -151,8 +152,20 @@ SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableF
     p.experiment = experiment[fit.names[k]];
     p.experiment_error = fit.scatter[k];
     panels.push_back(std::move(p));
+    double twin_drift = 0;
+    for (const SteadyStateRun& r : runs)
+      twin_drift += r.state.drift_of(fit.names[k]) / double(runs.size());
+    const double drift = experiment.drift_of(fit.names[k]);
+    // The twin's mean over its runs says it for the protocol; one run's drift is noisy.
+    if (std::abs(twin_drift) > fit.scatter[k]) {
+      o.notes.push_back(fit.names[k] + " still changes by " + json_number(twin_drift) +
+                        " across the window (the twin's runs' mean; one packing's scatter " +
+                        json_number(fit.scatter[k]) + "): not yet a steady state");
+    }
     j << (k ? ", " : "") << json_text(fit.names[k])
       << ": {\"experiment\": " << json_number(experiment[fit.names[k]])
+      << ", \"drift_over_window\": " << json_number(drift)
+      << ", \"twin_drift_over_window\": " << json_number(twin_drift)
       << ", \"model_at_fit\": " << json_number(fit.model[k])
       << ", \"packing_scatter\": " << json_number(fit.scatter[k])
       << ", \"log_mu_s_resolution\": " << json_number(fit.resolution[k]) << "}";
@@ -292,7 +305,10 @@ void fit_steady_state(const SteadyStateJob& job) {
   std::cout << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
             << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
             << " in ln mu_s on " << fit.cross_validations << " runs\n"
-            << "wrote " << (job.out / "summary.json").string() << ", steady_state_runs.csv, "
+            << "";
+  for (const std::string& note : written.notes)
+    std::cout << "  note: " << note << "\n";
+  std::cout << "wrote " << (job.out / "summary.json").string() << ", steady_state_runs.csv, "
             << written.written.size() + compared.written.size() << " figure files\n";
 }
 

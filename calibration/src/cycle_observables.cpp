@@ -166,6 +166,11 @@ double SteadyState::operator[](const std::string& name) const {
   return it == names.end() ? std::nan("") : values[std::size_t(it - names.begin())];
 }
 
+double SteadyState::drift_of(const std::string& name) const {
+  const auto it = std::find(names.begin(), names.end(), name);
+  return it == names.end() || drift.empty() ? std::nan("") : drift[std::size_t(it - names.begin())];
+}
+
 std::string steady_state_label(const std::string& name) {
   static const std::map<std::string, std::string> labels{
       {"rot_disp", "rotational displacement (d)"},
@@ -183,22 +188,32 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
   const auto [first, last] = observed.window;
   auto in_window = [&](std::int64_t c) { return c >= first && c <= last; };
   SteadyState s;
-  auto mean_of = [&](const std::vector<std::int64_t>& cycle, const std::vector<double>& value) {
-    double sum = 0;
-    std::size_t n = 0;
+  // The window's mean, and its least-squares change across the window (slope x cycles).
+  auto add = [&](const std::string& name, const std::vector<std::int64_t>& cycle,
+                 const std::vector<double>& value, bool always) {
+    std::vector<double> c, v;
     for (std::size_t k = 0; k < cycle.size() && k < value.size(); ++k) {
       if (in_window(cycle[k]) && std::isfinite(value[k])) {
-        sum += value[k];
-        ++n;
+        c.push_back(double(cycle[k]));
+        v.push_back(value[k]);
       }
     }
-    return n ? sum / double(n) : std::nan("");
+    if (v.empty() && !always) return;
+    const double n = double(v.size());
+    double mc = 0, mv = 0, scc = 0, scv = 0;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      mc += c[k] / n;
+      mv += v[k] / n;
+    }
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      scc += (c[k] - mc) * (c[k] - mc);
+      scv += (c[k] - mc) * (v[k] - mv);
+    }
+    s.names.push_back(name);
+    s.values.push_back(v.empty() ? kNaN : mv);
+    s.drift.push_back(scc > 0 ? scv / scc * double(last - first) : kNaN);
   };
-  const double rot = mean_of(observed.cycle, observed.mean_rot_disp);
-  if (std::isfinite(rot)) {
-    s.names.push_back("rot_disp");
-    s.values.push_back(rot);
-  }
+  add("rot_disp", observed.cycle, observed.mean_rot_disp, false);
   std::vector<std::int64_t> cycles;
   std::vector<double> packing, coordination, from_height;
   // The container's cross-section, in the positions' unit (NaN: no box).
@@ -213,19 +228,12 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
     coordination.push_back(p.coordination);
     from_height.push_back(height_packing_fraction(position, h.radius, section));
   }
-  s.names.insert(s.names.end(), {"bulk_packing_fraction", "coordination"});
-  s.values.insert(s.values.end(), {mean_of(cycles, packing), mean_of(cycles, coordination)});
-  if (h.box) {
-    s.names.push_back("height_packing_fraction");
-    s.values.push_back(mean_of(cycles, from_height));
-  }
+  add("bulk_packing_fraction", cycles, packing, true);
+  add("coordination", cycles, coordination, true);
+  if (h.box) add("height_packing_fraction", cycles, from_height, true);
   for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
     const auto it = run.observables().find(name);
-    if (it == run.observables().end()) continue;
-    const double v = mean_of(it->second.step, it->second.value);
-    if (!std::isfinite(v)) continue;
-    s.names.push_back(name);
-    s.values.push_back(v);
+    if (it != run.observables().end()) add(name, it->second.step, it->second.value, false);
   }
   return s;
 }

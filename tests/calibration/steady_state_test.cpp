@@ -23,6 +23,7 @@ Trajectories cubic_run() {
   h.time_unit = "cycle";
   h.has_axis = true;
   const int n = 8;
+  h.box = Box{Eigen::Vector3d::Constant(-0.5), Eigen::Vector3d(n, n, 20)};  // 8 x 8 mm
   for (int k = 0; k < n * n * n; ++k) {
     h.id.push_back(k);
     h.radius.push_back(0.5);
@@ -56,13 +57,21 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   o.window = {3, 4};
   const SteadyState s = steady_state(run, cycle_observables(run, o));
   EXPECT_EQ(s.names, (std::vector<std::string>{"rot_disp", "bulk_packing_fraction", "coordination",
-                                               "packing_fraction", "wall_force_full_compression"}));
+                                               "height_packing_fraction", "packing_fraction",
+                                               "wall_force_full_compression"}));
   EXPECT_NEAR(s["rot_disp"], kTurn / 2, 1e-12);  // angle x d/2, in diameters
   EXPECT_NEAR(s["bulk_packing_fraction"], M_PI / 6, 1e-12);
   EXPECT_DOUBLE_EQ(s["coordination"], 6);
-  EXPECT_DOUBLE_EQ(s["packing_fraction"], 0.535);  // cycles 3 and 4 only
+  EXPECT_NEAR(s["height_packing_fraction"], M_PI / 6, 1e-12);  // 8 layers on 8 x 8 mm
+  EXPECT_DOUBLE_EQ(s["packing_fraction"], 0.535);              // cycles 3 and 4 only
   EXPECT_DOUBLE_EQ(s["wall_force_full_compression"], 35);
   EXPECT_TRUE(std::isnan(s["lid_height"]));
+  // Across the window (cycles 3 to 4): the store's values rise by 0.01 and 10 per cycle,
+  // the rotation per cycle and the lattice do not change.
+  EXPECT_NEAR(s.drift_of("packing_fraction"), 0.01, 1e-12);
+  EXPECT_NEAR(s.drift_of("wall_force_full_compression"), 10, 1e-12);
+  EXPECT_NEAR(s.drift_of("rot_disp"), 0, 1e-12);
+  EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
 }
 
 }  // namespace

@@ -84,8 +84,12 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
 struct SteadyState {
   std::vector<std::string> names;
   std::vector<double> values;
+  // Each one's change across the window (its least-squares slope per cycle times the
+  // window's cycles): a steady state's is within the scatter of one packing's value.
+  std::vector<double> drift;
   // The value of `name`, NaN when the run has none.
   double operator[](const std::string& name) const;
+  double drift_of(const std::string& name) const;
 };
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
                          const StructureOptions& structure = {});

@@ -492,6 +492,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     const RunHeader& h = experiment.header();
     const PhysicsOptions physics = physics_from(v);
     const DepositOptions d = deposit_from(v);
+    d.validate();  // before any work or output
     physics.validate("calibrate", d.radius * (1 - d.polydispersity));
     check_against_experiment(h, args->experiment, v, d.box_side);
 

@@ -105,6 +105,7 @@ SimulateSettings add_simulate(CLI::App& app) {
     }
     const PhysicsOptions physics = physics_from(v);
     const DepositOptions d = deposit_from(v);
+    d.validate();  // before any work or output
     const double box = d.box_side;
     const double radius = d.radius;
     const std::string out = v.at("out");

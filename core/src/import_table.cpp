@@ -1,7 +1,5 @@
 #include "granmem/core/import_table.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,6 +7,7 @@
 #include <unordered_map>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/memory_budget.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/units.hpp"
 
@@ -49,13 +48,6 @@ void check_dense_size(const std::filesystem::path& csv, std::size_t rows, std::s
   const double slots = double(frames) * double(particles);
   const double bytes = slots * (3 + 3 + 2) * sizeof(double);  // positions, axes, rows, flags
   const double filled = double(rows) / slots;
-  const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGESIZE));
-  auto size = [](double b) {
-    std::ostringstream s;
-    s.precision(2);
-    s << b / (1 << 30) << " GiB";
-    return s.str();
-  };
   const std::string shape = std::to_string(rows) + " rows label " + std::to_string(frames) +
                             " frames x " + std::to_string(particles) + " particles";
   if (slots > 1e6 && filled < 0.01) {
@@ -65,12 +57,9 @@ void check_dense_size(const std::filesystem::path& csv, std::size_t rows, std::s
     throw Error(csv.string() + ": " + shape + ", of which " + fill.str() +
                 " % are in the table: is 'particle' a track id that is the same grain in every "
                 "frame? (the store holds every frame of every particle, " +
-                size(bytes) + ")");
+                gibibytes(bytes) + ")");
   }
-  if (memory > 0 && bytes > 0.5 * memory) {
-    throw Error(csv.string() + ": " + shape + ": the store would take " + size(bytes) +
-                ", more than half of this machine's " + size(memory));
-  }
+  check_memory_budget(bytes, csv.string() + ": " + shape + ": the store");
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/memory_budget.hpp"
 #include "granmem/sim/spatial_order.hpp"
 
 namespace granmem {
@@ -65,17 +66,24 @@ double settle(Simulation& sim, const DepositOptions& o, const std::string& stage
   return sim.time() - start;
 }
 
-Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
-  if (o.grains < 1) throw Error("deposit: needs at least one grain");
-  if (!(o.radius > 0)) throw Error("deposit: grain radius must be positive");
-  if (!(o.polydispersity >= 0 && o.polydispersity < 1)) {
+void DepositOptions::validate() const {
+  if (grains < 1) throw Error("deposit: needs at least one grain");
+  // ~2.4-3.1 KB a grain measured (docs/BENCHMARKS.md, state, neighbour lists, contacts).
+  check_memory_budget(3e3 * double(grains),
+                      "deposit: " + std::to_string(grains) + " grains (~3 KB each)");
+  if (!(radius > 0)) throw Error("deposit: grain radius must be positive");
+  if (!(polydispersity >= 0 && polydispersity < 1)) {
     throw Error("deposit: polydispersity must be in [0, 1)");
   }
-  const double r_max = o.radius * (1 + o.polydispersity);
-  if (!(o.box_side > 6 * r_max)) {
+  if (!(box_side > 6 * radius * (1 + polydispersity))) {
     throw Error("deposit: the box must be wider than three grains");
   }
-  if (!(o.lid_mass >= 0)) throw Error("deposit: lid mass must be zero or positive");
+  if (!(lid_mass >= 0)) throw Error("deposit: lid mass must be zero or positive");
+}
+
+Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
+  o.validate();
+  const double r_max = o.radius * (1 + o.polydispersity);
   physics.validate("deposit", o.radius * (1 - o.polydispersity));
 
   // A loose lattice with gaps, so that random shifts never make grains overlap each other

@@ -396,6 +396,13 @@ TEST_F(BadInputTest, MissingFile) {
   expect_clean_failure({"export", "nothere.h5", "--out", "x.dump"}, {"nothere.h5"});
 }
 
+// Absurd sizes are refused before anything is allocated, with what they would take.
+TEST_F(BadInputTest, GrainsBeyondTheMachinesMemoryAreRefusedBeforeTheWork) {
+  expect_clean_failure({"simulate", "--grains", "1e11", "--out", "big.h5", "--cycles", "1"},
+                       {"deposit", "100000000000 grains", "more than half of this machine's"});
+  EXPECT_FALSE(std::filesystem::exists(in_work("big.h5")));
+}
+
 TEST_F(BadInputTest, AnalyzeBadOptions) {
   make_good_outputs();
   const auto analyze = [](std::vector<std::string> extra) {

@@ -3,6 +3,8 @@
 // each kind of bad file.
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include <tuple>
 
 #include "granmem/core/error.hpp"
@@ -296,6 +298,24 @@ TEST_F(TiffStackTest, GarbageIsNotATiff) {
   write_bytes(path("empty.tif"), "");
   expect_read_error(path("empty.tif"), {"empty file"});
   expect_read_error(path("missing.tif"), {"no such file"});
+}
+
+// A 138-byte file whose one page declares 100000 x 100000 16-bit pixels (20 GB): refused
+// from its length before anything is allocated (it used to take 11 GB and run on).
+TEST_F(TiffStackTest, AbsurdDeclaredSizesAreRefusedBeforeAllocating) {
+  auto u16 = [](std::uint32_t v) { return std::string{char(v & 0xff), char(v >> 8)}; };
+  auto u32 = [&](std::uint32_t v) { return u16(v & 0xffff) + u16(v >> 16); };
+  const std::uint32_t side = 100000;
+  const std::vector<std::array<std::uint32_t, 3>> tags{
+      {256, 4, side}, {257, 4, side}, {258, 3, 16},   {259, 3, 1},          {262, 3, 1},
+      {273, 4, 8},    {277, 3, 1},    {278, 4, side}, {279, 4, 4000000000u}};
+  std::string bytes = std::string("II*\0", 4) + u32(24) + std::string(16, '\0') + u16(9);
+  for (const auto& [tag, type, value] : tags)
+    bytes += u16(tag) + u16(type) + u32(1) + (type == 3 ? u16(value) + u16(0) : u32(value));
+  bytes += u32(0);
+  write_bytes(path("huge.tif"), bytes);
+  expect_read_error(path("huge.tif"),
+                    {"1 page of 100000x100000 pixels", "more than any compression", "138 bytes"});
 }
 
 TEST_F(TiffStackTest, PagesOfUnequalSizeAreRefused) {

@@ -6,6 +6,7 @@
 #include <new>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/memory_budget.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/stack.hpp"
 #include "stack_formats.hpp"
@@ -76,6 +77,10 @@ Box resolve_region(const std::optional<Region>& region, std::int64_t nx, std::in
 }
 
 Stack allocate_stack(const Box& box, int bits, const std::string& source) {
+  check_memory_budget(2.0 * double(box.nx) * double(box.ny) * double(box.nz),
+                      source + ": a stack of " + std::to_string(box.nx) + "x" +
+                          std::to_string(box.ny) + "x" + std::to_string(box.nz) +
+                          " voxels (read a region of it)");
   try {
     return Stack(box.nx, box.ny, box.nz, bits);
   } catch (const std::bad_alloc&) {

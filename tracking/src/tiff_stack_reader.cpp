@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/memory_budget.hpp"
 #include "stack_formats.hpp"
 #include "tiff_file.hpp"
 #include "tiff_metadata.hpp"
@@ -74,6 +75,22 @@ void read_imagej_contiguous(TiffFile& file, const std::filesystem::path& path, c
   }
 }
 
+// A header can declare any size: what the file's length can hold bounds it before anything
+// is allocated (no TIFF compression packs more than about 1,000:1; deflate's limit is 1,032).
+void check_declared_size(TiffFile& file, const std::filesystem::path& path, const TiffPage& page,
+                         std::int64_t pages) {
+  std::error_code ec;
+  const double length = double(std::filesystem::file_size(path, ec));
+  const double declared =
+      double(page.width) * double(page.height) * double(page.bits / 8) * double(pages);
+  if (!ec && declared > 1100 * length) {
+    file.fail(std::to_string(pages) + (pages == 1 ? " page" : " pages") + " of " +
+              std::to_string(page.width) + "x" + std::to_string(page.height) + " pixels declare " +
+              gibibytes(declared) + ", more than any compression holds in the file's " +
+              std::to_string(std::int64_t(length)) + " bytes (truncated or corrupt?)");
+  }
+}
+
 }  // namespace
 
 Stack read_tiff_stack(const std::filesystem::path& path, const std::optional<Region>& region) {
@@ -98,6 +115,7 @@ Stack read_tiff_stack(const std::filesystem::path& path, const std::optional<Reg
               " pages (file truncated?)");
   }
 
+  check_declared_size(file, path, first, pages);
   const Box box = resolve_region(region, first.width, first.height, pages, path.string());
   Stack stack = allocate_stack(box, first.bits, path.string());
   stack.voxel_size = meta.voxel_size;

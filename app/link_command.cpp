@@ -8,6 +8,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectory_store.hpp"
+#include "granmem/core/units.hpp"
 #include "granmem/core/xdmf.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/link.hpp"
@@ -69,6 +70,10 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
   cmd->add_flag("--no-drift", args.no_drift,
                 "do not estimate the collective motion (drift, uniform deformation, local "
                 "displacement field) between scans");
+  cmd->add_option("--container", args.container,
+                  "the container in the scans' frame, xmin,ymin,zmin,xmax,ymax,zmax with a unit "
+                  "(e.g. 1.2,0.8,0.5,6.2,5.8,7.5cm): positions are stored in its frame and it "
+                  "is the store's box, as the DEM's");
   cmd->add_option("--report", args.report,
                   "CSV of what could not be linked: tracks lost and detections starting a track");
 }
@@ -77,6 +82,17 @@ std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out
   std::vector<NamedPath> outputs{{"--out", out}, {"--out's XDMF", xdmf_path(out)}};
   if (!args.report.empty()) outputs.push_back({"--report", args.report});
   return outputs;
+}
+
+void validate(const LinkArgs& args) {
+  if (args.container.empty()) return;
+  const Quantity last = parse_quantity_list(args.container, "--container").back();
+  if (!is_physical_length_unit(last.unit)) {
+    throw Error("--container '" + args.container +
+                "': expected xmin,ymin,zmin,xmax,ymax,zmax with a length unit, e.g. "
+                "0,0,0,5,5,7cm");
+  }
+  parse_box(args.container, "--container", last.unit);  // six values, each max above its min
 }
 
 void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
@@ -109,6 +125,9 @@ void link_and_write(std::vector<Detections> scans, const std::vector<std::string
 
   LinkSummary summary;
   Trajectories run = link_scans(scans, options, &summary);
+  if (!args.container.empty()) {
+    register_to_container(run, parse_box(args.container, "--container", unit));
+  }
   for (const auto& [key, value] : used_options(cmd))
     run.header.parameters[key] = value;
 
@@ -173,6 +192,7 @@ void add_link(CLI::App& app) {
     std::vector<NamedPath> inputs;
     for (const std::string& path : args->scans)
       inputs.push_back({"scan", path});
+    validate(args->link);
     check_outputs(link_outputs(args->link, args->out), inputs);
     std::vector<Detections> scans;
     scans.reserve(args->scans.size());

@@ -194,6 +194,7 @@ void add_track(CLI::App& app) {
       const std::filesystem::path name = std::filesystem::path(scan).filename();
       return std::filesystem::path(args->detections) / (name.stem().string() + ".h5");
     };
+    validate(args->link);
     std::vector<NamedPath> inputs, outputs = link_outputs(args->link, args->out);
     for (const std::string& scan : scans) {
       if (!std::filesystem::exists(scan)) throw Error("scan " + scan + ": no such file or folder");

@@ -26,16 +26,23 @@ double plain_number(const std::string& text, const std::string& option) {
 
 }  // namespace
 
-Box parse_box(const std::string& text, const std::string& option) {
+Box parse_box(const std::string& text, const std::string& option, const std::string& run_unit) {
   const std::vector<Quantity> v = parse_quantity_list(text, option);
-  if (v.size() != 6 || !v.front().unit.empty()) {
-    throw Error(option + " '" + text +
-                "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax in the table's unit");
+  const std::string unit = v.empty() ? "" : v.front().unit;
+  const bool convert = !unit.empty() && unit != run_unit;
+  if (v.size() != 6 || (convert && (run_unit.empty() || !is_physical_length_unit(unit) ||
+                                    !is_physical_length_unit(run_unit)))) {
+    throw Error(
+        option + " '" + text + "': expected six numbers xmin,ymin,zmin,xmax,ymax,zmax in " +
+        (run_unit.empty() ? std::string("the table's unit") : "a length unit or " + run_unit));
   }
   Box box;
   for (int k = 0; k < 3; ++k) {
-    box.lower[k] = v[std::size_t(k)].value;
-    box.edges[k] = v[std::size_t(k) + 3].value - box.lower[k];
+    auto at = [&](std::size_t i) {
+      return convert ? convert_length(v[i].value, unit, run_unit) : v[i].value;
+    };
+    box.lower[k] = at(std::size_t(k));
+    box.edges[k] = at(std::size_t(k) + 3) - box.lower[k];
   }
   if (!(box.edges.array() > 0).all() || !box.lower.allFinite() || !box.edges.allFinite()) {
     throw Error(option + " '" + text + "': each max must be greater than its min");

@@ -12,7 +12,7 @@
 namespace granmem::app {
 
 // "xmin,ymin,zmin,xmax,ymax,zmax" -> Box.
-Box parse_box(const std::string& text, const std::string& option);
+Box parse_box(const std::string& text, const std::string& option, const std::string& run_unit = "");
 // "A:B" -> (A, B), integers.
 std::pair<std::int64_t, std::int64_t> parse_int_range(const std::string& text,
                                                       const std::string& option);

@@ -25,11 +25,13 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args);
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame);
 
 struct LinkArgs {
-  std::string max_displacement = "auto", report;
+  std::string max_displacement = "auto", report, container;
   int memory = 2;
   bool no_drift = false;
 };
 void add_link_options(CLI::App* cmd, LinkArgs& args);
+// Checks what can be checked before any scan is read (--container's form and unit).
+void validate(const LinkArgs& args);
 // The files linking writes: the store `out`, its XDMF and the --report.
 std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out);
 // Links the scans (`names` for messages), writes the trajectory store `out` with `cmd`'s

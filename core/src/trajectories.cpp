@@ -62,4 +62,14 @@ void check_header(const RunHeader& header, const std::string& where) {
   }
 }
 
+void register_to_container(Trajectories& run, const Box& container) {
+  if (!container.lower.allFinite() || !(container.edges.array() > 0).all() ||
+      !container.edges.allFinite()) {
+    throw Error("container: its edges must be positive and finite");
+  }
+  for (Frame& frame : run.frames)
+    frame.position.rowwise() -= container.lower.transpose();
+  run.header.box = Box{Eigen::Vector3d::Zero(), container.edges};
+}
+
 }  // namespace granmem

@@ -179,6 +179,32 @@ TEST_F(LinkCommandTest, NoDriftLosesTheGrains) {
   EXPECT_EQ(run.header.parameters.at("link/max_displacement"), "0.4 mm");
 }
 
+// The container given in the scans' frame (in cm, the scans in mm): positions stored from
+// its lower corner, and it is the store's box, so a scan's fields share the DEM's frame.
+TEST_F(LinkCommandTest, PositionsAreStoredInTheContainersFrame) {
+  granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "plain.h5"});
+  granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "boxed.h5", "--container",
+              "-0.1,0.2,0.3,4.9,5.2,7.3cm"});
+  const Trajectories plain = read_trajectories(in_work("plain.h5"));
+  const Trajectories boxed = read_trajectories(in_work("boxed.h5"));
+  ASSERT_TRUE(boxed.header.box.has_value());
+  EXPECT_TRUE(boxed.header.box->lower.isZero());
+  EXPECT_TRUE(boxed.header.box->edges.isApprox(Eigen::Vector3d(50, 50, 70)));
+  for (std::size_t t = 0; t < plain.frames.size(); ++t) {
+    const Eigen::MatrixXd shift = plain.frames[t].position - boxed.frames[t].position;
+    for (Eigen::Index k = 0; k < shift.rows(); ++k) {
+      if (!shift.row(k).allFinite()) continue;
+      EXPECT_TRUE(shift.row(k).isApprox(Eigen::RowVector3d(-1, 2, 3), 1e-9)) << shift.row(k);
+    }
+  }
+  expect_clean_failure(
+      {"link", "scan0.h5", "scan1.csv", "--out", "x.h5", "--container", "0,0,0,5,5,7"},
+      {"--container", "length unit"});
+  expect_clean_failure(
+      {"link", "scan0.h5", "scan1.csv", "--out", "x.h5", "--container", "0,0,0,5,-5,7cm"},
+      {"--container", "greater than its min"});
+}
+
 using LinkBadInputTest = LinkCommandTest;
 
 TEST_F(LinkBadInputTest, Errors) {

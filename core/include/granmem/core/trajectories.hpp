@@ -78,6 +78,13 @@ struct Trajectories {
   std::map<std::string, Observable> observables;
 };
 
+// The run in its container's frame: every frame's positions less the container's lower
+// corner (given in the positions' frame, e.g. a scan's), and the container, from the
+// origin, as the run's box: tracked scans then share the DEM's coordinates, so their
+// fields and wall distances compare without an offset. Throws Error for a container
+// without positive edges.
+void register_to_container(Trajectories& run, const Box& container);
+
 // Checks a header for consistency (sizes, unique ids, known units); throws Error naming `where`.
 void check_header(const RunHeader& header, const std::string& where);
 

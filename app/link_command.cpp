@@ -74,6 +74,10 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
                   "the container in the scans' frame, xmin,ymin,zmin,xmax,ymax,zmax with a unit "
                   "(e.g. 1.2,0.8,0.5,6.2,5.8,7.5cm): positions are stored in its frame and it "
                   "is the store's box, as the DEM's");
+  cmd->add_option("--container-size", args.container_size,
+                  "the container's edges LX,LY,LZ with a unit, its position found from the "
+                  "packing's extent in the first scan (lowest x - r, y - r, z - r: grains "
+                  "pressed into it touch its floor and walls); instead of --container");
   cmd->add_option("--report", args.report,
                   "CSV of what could not be linked: tracks lost and detections starting a track");
 }
@@ -84,7 +88,28 @@ std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out
   return outputs;
 }
 
+// "LX,LY,LZ<unit>" -> the edges in `unit` (Error without a length unit or a positive edge).
+Eigen::Vector3d parse_edges(const std::string& text, const std::string& unit) {
+  const std::vector<Quantity> v = parse_quantity_list(text, "--container-size");
+  if (v.size() != 3 || !is_physical_length_unit(v.back().unit)) {
+    throw Error("--container-size '" + text +
+                "': expected LX,LY,LZ with a length unit, e.g. 5,5,7cm");
+  }
+  Eigen::Vector3d edges;
+  for (int a = 0; a < 3; ++a) {
+    edges[a] = convert_length(v[std::size_t(a)].value, v.back().unit, unit);
+    if (!(edges[a] > 0) || !std::isfinite(edges[a])) {
+      throw Error("--container-size '" + text + "': each edge must be positive");
+    }
+  }
+  return edges;
+}
+
 void validate(const LinkArgs& args) {
+  if (!args.container.empty() && !args.container_size.empty()) {
+    throw Error("--container and --container-size: give the container or its size, not both");
+  }
+  if (!args.container_size.empty()) parse_edges(args.container_size, "m");
   if (args.container.empty()) return;
   const Quantity last = parse_quantity_list(args.container, "--container").back();
   if (!is_physical_length_unit(last.unit)) {
@@ -127,6 +152,11 @@ void link_and_write(std::vector<Detections> scans, const std::vector<std::string
   Trajectories run = link_scans(scans, options, &summary);
   if (!args.container.empty()) {
     register_to_container(run, parse_box(args.container, "--container", unit));
+  } else if (!args.container_size.empty()) {
+    const Box found = container_from_extent(run, parse_edges(args.container_size, unit));
+    std::cerr << "container found from the packing's extent: lower corner " << found.lower.x()
+              << "," << found.lower.y() << "," << found.lower.z() << " " << unit << "\n";
+    register_to_container(run, found);
   }
   for (const auto& [key, value] : used_options(cmd))
     run.header.parameters[key] = value;

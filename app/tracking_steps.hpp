@@ -25,7 +25,7 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args);
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame);
 
 struct LinkArgs {
-  std::string max_displacement = "auto", report, container;
+  std::string max_displacement = "auto", report, container, container_size;
   int memory = 2;
   bool no_drift = false;
 };

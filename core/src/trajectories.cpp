@@ -1,7 +1,7 @@
 #include "granmem/core/trajectories.hpp"
 
+#include <cmath>
 #include <limits>
-
 #include <unordered_set>
 
 #include "granmem/core/error.hpp"
@@ -70,6 +70,23 @@ void register_to_container(Trajectories& run, const Box& container) {
   for (Frame& frame : run.frames)
     frame.position.rowwise() -= container.lower.transpose();
   run.header.box = Box{Eigen::Vector3d::Zero(), container.edges};
+}
+
+Box container_from_extent(const Trajectories& run, const Eigen::Vector3d& edges) {
+  Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  if (!run.frames.empty()) {
+    const Frame& f = run.frames.front();
+    for (Eigen::Index k = 0; k < f.position.rows(); ++k) {
+      const double r = std::size_t(k) < run.header.radius.size() ? run.header.radius[std::size_t(k)]
+                                                                 : std::nan("");
+      if (!f.position.row(k).allFinite() || !std::isfinite(r)) continue;
+      lower = lower.cwiseMin(f.position.row(k).transpose() - Eigen::Vector3d::Constant(r));
+    }
+  }
+  if (!lower.allFinite()) {
+    throw Error("container: the first frame has no grain with a position and a radius");
+  }
+  return Box{lower, edges};
 }
 
 }  // namespace granmem

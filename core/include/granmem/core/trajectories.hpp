@@ -85,6 +85,11 @@ struct Trajectories {
 // without positive edges.
 void register_to_container(Trajectories& run, const Box& container);
 
+// The container of edges `edges` found from the packing's extent in the first frame: its
+// lower corner where the grains' surfaces end (lowest x - r, y - r, z - r), since grains
+// pressed into a container touch its floor and walls. Error for a run without positions.
+Box container_from_extent(const Trajectories& run, const Eigen::Vector3d& edges);
+
 // Checks a header for consistency (sizes, unique ids, known units); throws Error naming `where`.
 void check_header(const RunHeader& header, const std::string& where);
 

@@ -477,6 +477,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       mu_r = parse_frictions(v.at("mu-r"), "--mu-r");
       v["mu-r"] = json_number(mu_r.front());  // each run sets its own
     }
+    if (args->fit_only && args->observables != "steady-state") {
+      throw Error(
+          "--fit-only: only with --observables steady-state (the displacement fit "
+          "compares its distributions at the fit)");
+    }
     if (joint && args->observables != "steady-state") {
       throw Error("--fit mu_s,mu_r: the joint fit is on --observables steady-state");
     }

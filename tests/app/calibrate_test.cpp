@@ -70,6 +70,7 @@ TEST_F(Calibrate, RefusesBadInput) {
   other[7] = "3%";  // the amplitude
   expect_clean_failure(calibrate({}, other), {"exp.h5", "amplitude 5%", "twin has 3%"});
   expect_clean_failure(calibrate({"--noise", "fit"}), {"--noise", "voxel size"});
+  expect_clean_failure(calibrate({"--fit-only"}), {"--fit-only", "steady-state"});
 }
 
 TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {

@@ -304,8 +304,7 @@ void fit_steady_state(const SteadyStateJob& job) {
   print_observables(fit.names, &fit.resolution, job);
   std::cout << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
             << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
-            << " in ln mu_s on " << fit.cross_validations << " runs\n"
-            << "";
+            << " in ln mu_s on " << fit.cross_validations << " runs\n";
   for (const std::string& note : written.notes)
     std::cout << "  note: " << note << "\n";
   std::cout << "wrote " << (job.out / "summary.json").string() << ", steady_state_runs.csv, "
@@ -430,15 +429,16 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->check(CLI::IsMember({"pooled", "per-cycle"}));
   cmd->add_option("--observables", args->observables,
                   "displacements: the distribution of end-of-cycle displacements (--summaries); "
-                  "steady-state: the window means of the rotation, the packing fraction and "
-                  "coordination from positions, and the lid's packing fraction and the wall "
-                  "force where the experiment has them (docs/CALIBRATION.md)")
+                  "steady-state: the window means of the rotation, the packing fraction from "
+                  "the packing's height and in its bulk, the coordination, all from positions, "
+                  "and the wall force where the experiment has it (docs/CALIBRATION.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"displacements", "steady-state"}));
   cmd->add_option("--only", args->only,
                   "steady-state: fit only these observables, comma list (rot_disp, "
-                  "bulk_packing_fraction, coordination, packing_fraction, "
-                  "wall_force_full_compression); default all the experiment has");
+                  "bulk_packing_fraction, coordination, height_packing_fraction, "
+                  "packing_fraction, wall_force_full_compression); default all the experiment "
+                  "has, the lid's packing_fraction left out where the height's is there");
   cmd->add_option("--fit", args->fit,
                   "the frictions fitted: mu_s, or mu_s,mu_r jointly (steady-state observables; "
                   "--mu-r is then the list of rolling frictions simulated, e.g. "

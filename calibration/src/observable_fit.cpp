@@ -282,6 +282,18 @@ std::vector<std::string> common_observables(const SteadyState& experiment,
   return names;
 }
 
+// A fit on the observables common_observables() picks, its `names` set to them.
+template <class Fit>
+auto fit_by_name(const SteadyState& experiment, const std::vector<SteadyStateRun>& runs,
+                 const std::vector<std::string>& only, const Fit& fit) {
+  std::vector<double> measured;
+  std::vector<ObservableRun> twin;
+  std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
+  auto result = fit(measured, twin);
+  result.names = std::move(names);
+  return result;
+}
+
 std::string method_text(std::size_t observables, const std::string& variables, int degree,
                         std::size_t runs, double spare, std::size_t cross_validations) {
   return "Ceres generalized least squares of " + std::to_string(observables) +
@@ -366,12 +378,9 @@ ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
                                            const std::vector<SteadyStateRun>& runs,
                                            const ObservableFitOptions& options,
                                            const std::vector<std::string>& only) {
-  std::vector<double> measured;
-  std::vector<ObservableRun> twin;
-  const std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
-  ObservableFit fit = fit_friction_to_observables(measured, twin, options);
-  fit.names = names;
-  return fit;
+  return fit_by_name(experiment, runs, only, [&](const auto& measured, const auto& twin) {
+    return fit_friction_to_observables(measured, twin, options);
+  });
 }
 
 JointObservableFit fit_frictions_to_observables(const std::vector<double>& experiment,
@@ -434,12 +443,9 @@ JointObservableFit fit_frictions_to_steady_state(const SteadyState& experiment,
                                                  const std::vector<SteadyStateRun>& runs,
                                                  const ObservableFitOptions& options,
                                                  const std::vector<std::string>& only) {
-  std::vector<double> measured;
-  std::vector<ObservableRun> twin;
-  const std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
-  JointObservableFit fit = fit_frictions_to_observables(measured, twin, options);
-  fit.names = names;
-  return fit;
+  return fit_by_name(experiment, runs, only, [&](const auto& measured, const auto& twin) {
+    return fit_frictions_to_observables(measured, twin, options);
+  });
 }
 
 }  // namespace granmem

@@ -6,9 +6,9 @@
 
 #include "commands.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/rotation/motion_analysis.hpp"
-#include "parse.hpp"
 
 namespace granmem::app {
 namespace {
@@ -120,10 +120,7 @@ void add_analyze(CLI::App& app) {
     options.motion.wall_distance =
         parse_length(args->wall_distance, h.length_unit, "--wall-distance");
     if (!args->box.empty()) options.motion.box = parse_box(args->box, "--box");
-    options.motion.hole_contacts = args->hole_contacts == "exclude" ? HoleContactPolicy::exclude
-                                   : args->hole_contacts == "exclude-rotations"
-                                       ? HoleContactPolicy::exclude_rotations
-                                       : HoleContactPolicy::keep;
+    options.motion.hole_contacts = hole_contact_policy(args->hole_contacts, "--hole-contacts");
     options.pdf_quantities = split_list(args->pdf);
     if (!args->pdf_frames.empty()) {
       options.pdf_frames = parse_int_range(args->pdf_frames, "--pdf-frames");

@@ -17,10 +17,10 @@
 #include "granmem/calibration/observable_fit.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/ranks.hpp"
-#include "parse.hpp"
 #include "simulation_settings.hpp"
 
 namespace granmem::app {

@@ -3,8 +3,8 @@
 #include "commands.hpp"
 #include "comparison_report.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
-#include "parse.hpp"
 
 namespace granmem::app {
 

@@ -4,10 +4,10 @@
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/import_table.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/core/xdmf.hpp"
-#include "parse.hpp"
 
 namespace granmem::app {
 

@@ -6,13 +6,13 @@
 #include "commands.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/core/xdmf.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/link.hpp"
-#include "parse.hpp"
 #include "tracking_steps.hpp"
 
 namespace granmem::app {
@@ -88,28 +88,11 @@ std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out
   return outputs;
 }
 
-// "LX,LY,LZ<unit>" -> the edges in `unit` (Error without a length unit or a positive edge).
-Eigen::Vector3d parse_edges(const std::string& text, const std::string& unit) {
-  const std::vector<Quantity> v = parse_quantity_list(text, "--container-size");
-  if (v.size() != 3 || !is_physical_length_unit(v.back().unit)) {
-    throw Error("--container-size '" + text +
-                "': expected LX,LY,LZ with a length unit, e.g. 5,5,7cm");
-  }
-  Eigen::Vector3d edges;
-  for (int a = 0; a < 3; ++a) {
-    edges[a] = convert_length(v[std::size_t(a)].value, v.back().unit, unit);
-    if (!(edges[a] > 0) || !std::isfinite(edges[a])) {
-      throw Error("--container-size '" + text + "': each edge must be positive");
-    }
-  }
-  return edges;
-}
-
 void validate(const LinkArgs& args) {
   if (!args.container.empty() && !args.container_size.empty()) {
     throw Error("--container and --container-size: give the container or its size, not both");
   }
-  if (!args.container_size.empty()) parse_edges(args.container_size, "m");
+  if (!args.container_size.empty()) parse_edges(args.container_size, "m", "--container-size");
   if (args.container.empty()) return;
   const Quantity last = parse_quantity_list(args.container, "--container").back();
   if (!is_physical_length_unit(last.unit)) {
@@ -153,7 +136,8 @@ void link_and_write(std::vector<Detections> scans, const std::vector<std::string
   if (!args.container.empty()) {
     register_to_container(run, parse_box(args.container, "--container", unit));
   } else if (!args.container_size.empty()) {
-    const Box found = container_from_extent(run, parse_edges(args.container_size, unit));
+    const Box found =
+        container_from_extent(run, parse_edges(args.container_size, unit, "--container-size"));
     std::cerr << "container found from the packing's extent: lower corner " << found.lower.x()
               << "," << found.lower.y() << "," << found.lower.z() << " " << unit << "\n";
     register_to_container(run, found);

@@ -6,10 +6,10 @@
 #include "commands.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/locate.hpp"
 #include "granmem/tracking/stack.hpp"
-#include "parse.hpp"
 #include "tracking_steps.hpp"
 
 namespace granmem::app {
@@ -34,24 +34,6 @@ Region parse_region(const std::string& text) {
   }
   if (v.size() != 6) throw Error("--region '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels");
   return Region{v[0], v[1], v[2], v[3], v[4], v[5]};
-}
-
-// The grain diameter in voxels along x: "12" or "12 vox" (or px), or a length with the
-// stack's voxel size.
-double diameter_voxels(const std::string& text, const Stack& stack) {
-  const Quantity q = parse_quantity(text, "--diameter");
-  if (!std::isfinite(q.value) || !(q.value > 0)) {
-    throw Error("--diameter '" + text + "': expected a positive diameter");
-  }
-  if (q.unit.empty() || q.unit == "vox" || q.unit == "voxel" || q.unit == "px") return q.value;
-  if (!is_physical_length_unit(q.unit)) {
-    throw Error("--diameter '" + text + "': unknown unit " + q.unit + " (m, cm, mm, um, vox)");
-  }
-  if (!stack.voxel_size) {
-    throw Error("--diameter '" + text + "': " + stack.source +
-                " has no voxel size: give the diameter in voxels, or --voxel-size");
-  }
-  return convert_length(q.value, q.unit, stack.unit) / stack.voxel_size->x();
 }
 
 }  // namespace
@@ -105,7 +87,7 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
   }
   Stack stack = read_stack(path, read);
   LocateOptions o;
-  o.diameter = diameter_voxels(args.diameter, stack);
+  o.diameter = diameter_in_voxels(args.diameter, stack, "--diameter");
   o.dark_grains = args.polarity == "dark";
   o.hole_fraction = o.dark_grains ? args.hole_fraction : 0.0;
   o.beam_axis = args.beam == "y" ? 1 : 0;

@@ -4,8 +4,8 @@
 #include "commands.hpp"
 #include "granmem/calibration/readout.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/sim/ranks.hpp"
-#include "parse.hpp"
 
 namespace granmem::app {
 

@@ -6,11 +6,11 @@
 #include "commands.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/render.hpp"
 #include "granmem/tracking/stack.hpp"
-#include "parse.hpp"
 
 namespace granmem::app {
 namespace {

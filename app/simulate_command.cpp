@@ -13,12 +13,12 @@
 #include "commands.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/quasi_static.hpp"
 #include "granmem/sim/run_settings.hpp"
-#include "parse.hpp"
 #include "simulation_settings.hpp"
 
 namespace granmem::app {

@@ -10,6 +10,7 @@ packages=(
   gnuplot-nox
   libopenmpi-dev openmpi-bin
   lammps
+  python3-dev pybind11-dev python3-numpy python3-pandas python3-pytest python3-matplotlib
 )
 
 missing=()

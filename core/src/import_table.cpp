@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <sstream>
 #include <unordered_map>
 
@@ -14,13 +15,18 @@
 namespace granmem {
 namespace {
 
-std::string at(const std::filesystem::path& csv, std::size_t line) {
-  return csv.string() + " line " + std::to_string(line);
+// Where the rows come from, for messages: a CSV file's lines, or an in-memory table's rows.
+struct Source {
+  std::string name;
+  const char* row_word = "line";
+};
+
+std::string at(const Source& source, std::size_t line) {
+  return source.name + " " + source.row_word + " " + std::to_string(line);
 }
 
 // An integer label (frame or particle) stored in a double column.
-std::int64_t label(double v, const std::filesystem::path& csv, std::size_t line,
-                   const char* column) {
+std::int64_t label(double v, const Source& csv, std::size_t line, const char* column) {
   if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 9e15) {
     throw Error(at(csv, line) + ", column '" + column + "': expected an integer label, found " +
                 (std::isnan(v) ? std::string("nothing") : std::to_string(v)));
@@ -43,7 +49,7 @@ std::size_t index_of(const std::vector<std::int64_t>& sorted, std::int64_t value
 // 'particle' that is a row number, or a track id that changes every frame) would make a
 // store thousands of times its size: refused before anything is allocated, as is a store
 // beyond half of this machine's memory.
-void check_dense_size(const std::filesystem::path& csv, std::size_t rows, std::size_t frames,
+void check_dense_size(const Source& csv, std::size_t rows, std::size_t frames,
                       std::size_t particles) {
   const double slots = double(frames) * double(particles);
   const double bytes = slots * (3 + 3 + 2) * sizeof(double);  // positions, axes, rows, flags
@@ -54,24 +60,27 @@ void check_dense_size(const std::filesystem::path& csv, std::size_t rows, std::s
     std::ostringstream fill;
     fill.precision(2);
     fill << 100 * filled;
-    throw Error(csv.string() + ": " + shape + ", of which " + fill.str() +
+    throw Error(csv.name + ": " + shape + ", of which " + fill.str() +
                 " % are in the table: is 'particle' a track id that is the same grain in every "
                 "frame? (the store holds every frame of every particle, " +
                 gibibytes(bytes) + ")");
   }
-  check_memory_budget(bytes, csv.string() + ": " + shape + ": the store");
+  check_memory_budget(bytes, csv.name + ": " + shape + ": the store");
 }
 
-}  // namespace
+// The stored length unit and the scale from the table's unit to it, per axis, from the
+// options (checked).
+struct Scaling {
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+  std::string unit;
+};
 
-Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
-                          ImportSummary* summary) {
+Scaling scaling_of(const ImportOptions& options) {
   const std::string& unit = options.length_unit;
   if (!is_length_unit(unit)) {
     throw Error("--length-unit '" + unit + "': expected one of m, cm, mm, um, voxel");
   }
-  Eigen::Vector3d scale = Eigen::Vector3d::Ones();  // table unit -> stored unit, per axis
-  std::string stored_unit = unit;
+  Scaling s{Eigen::Vector3d::Ones(), unit};
   if (options.voxel_size) {
     if (unit != "voxel") {
       throw Error("--voxel-size applies to voxel coordinates, but --length-unit is " + unit);
@@ -82,31 +91,40 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
     if (!(options.voxel_size->array() > 0).all() || !options.voxel_size->allFinite()) {
       throw Error("--voxel-size: expected three positive sizes");
     }
-    scale = *options.voxel_size;
-    stored_unit = options.voxel_size_unit;
+    s.scale = *options.voxel_size;
+    s.unit = options.voxel_size_unit;
   }
-
   if (options.radius && !(*options.radius > 0 && std::isfinite(*options.radius))) {
     throw Error("--radius: expected a positive radius");
   }
+  return s;
+}
 
-  const CsvColumns read = read_csv(csv, {"frame", "particle", "x", "y", "z"},
-                                   {"ax", "ay", "az", "radius", "hole_contact"});
-  const Table& t = read.table;
+const std::vector<std::string> kRequiredColumns{"frame", "particle", "x", "y", "z"};
+const std::vector<std::string> kOptionalColumns{"ax", "ay", "az", "radius", "hole_contact"};
+
+Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, const Source& csv,
+                         const ImportOptions& options, ImportSummary* summary) {
+  const Scaling scaling = scaling_of(options);
+  const Eigen::Vector3d& scale = scaling.scale;
+  const std::string& stored_unit = scaling.unit;
   const std::size_t rows = t.rows();
-  if (rows == 0) throw Error(csv.string() + ": no rows after the header");
+  if (rows == 0) {
+    throw Error(csv.name +
+                (std::string(csv.row_word) == "line" ? ": no rows after the header" : ": no rows"));
+  }
   const bool has_axis = t.has("ax") || t.has("ay") || t.has("az");
   if (has_axis && !(t.has("ax") && t.has("ay") && t.has("az"))) {
-    throw Error(csv.string() + ": an axis needs all three columns ax, ay, az");
+    throw Error(csv.name + ": an axis needs all three columns ax, ay, az");
   }
   if (t.has("radius") && options.radius) {
-    throw Error(csv.string() + ": has a radius column; --radius is for tables without one");
+    throw Error(csv.name + ": has a radius column; --radius is for tables without one");
   }
 
   std::vector<std::int64_t> frame_of(rows), particle_of(rows);
   for (std::size_t r = 0; r < rows; ++r) {
-    frame_of[r] = label(t["frame"].values[r], csv, read.lines[r], "frame");
-    particle_of[r] = label(t["particle"].values[r], csv, read.lines[r], "particle");
+    frame_of[r] = label(t["frame"].values[r], csv, lines[r], "frame");
+    particle_of[r] = label(t["particle"].values[r], csv, lines[r], "particle");
   }
   const std::vector<std::int64_t> frames = sorted_unique(frame_of);
   const std::vector<std::int64_t> particles = sorted_unique(particle_of);
@@ -140,7 +158,7 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
   std::vector<std::size_t> seen_at(frames.size() * n, 0);  // line of the row, 0 = none
   std::size_t axes_known = 0;
   for (std::size_t r = 0; r < rows; ++r) {
-    const std::size_t line = read.lines[r];
+    const std::size_t line = lines[r];
     const std::size_t ti = index_of(frames, frame_of[r]);
     const std::size_t gi = index_of(particles, particle_of[r]);
     std::size_t& first = seen_at[ti * n + gi];
@@ -219,6 +237,25 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
     summary->length_unit = stored_unit;
   }
   return run;
+}
+
+}  // namespace
+
+Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
+                          ImportSummary* summary) {
+  scaling_of(options);  // bad options refused before the file is read
+  const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns);
+  return import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
+}
+
+Trajectories import_table(const Table& table, const std::string& source,
+                          const ImportOptions& options, ImportSummary* summary) {
+  for (const std::string& c : kRequiredColumns) {
+    if (!table.has(c)) throw Error(source + ": no column '" + c + "'");
+  }
+  std::vector<std::size_t> rows(table.rows());
+  std::iota(rows.begin(), rows.end(), std::size_t{1});
+  return import_rows(table, rows, Source{source, "row"}, options, summary);
 }
 
 }  // namespace granmem

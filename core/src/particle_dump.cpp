@@ -9,6 +9,8 @@
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/trajectory_table.hpp"
 
 namespace granmem {
 namespace {
@@ -45,10 +47,29 @@ void check_lammps_ids(const std::vector<std::int64_t>& ids, const std::filesyste
   }
 }
 
+// Frame by frame, so that a run larger than memory streams through.
+void write_track_table(const TrajectoryReader& run, const std::filesystem::path& out) {
+  const RunHeader& h = run.header();
+  AtomicFile file(out);
+  std::ofstream s(file.temp_path(), std::ios::binary);
+  if (!s) throw Error(out.string() + ": cannot open for writing");
+  s << csv_header(trajectory_table(h), {"granmem tracks of " + run.file_name() + ", lengths in " +
+                                        h.length_unit + ", time in " + h.time_unit});
+  for (std::size_t t = 0; t < run.frame_count(); ++t) {
+    Table rows = trajectory_table(h);
+    append_frame(rows, h, run.read_frame(t));
+    write_csv_rows(rows, s);
+  }
+  s.close();
+  if (!s) throw Error(out.string() + ": write failed (disk full?)");
+  file.commit();
+}
+
 }  // namespace
 
 void write_particle_dump(const TrajectoryReader& run, const std::filesystem::path& out,
                          DumpFormat format) {
+  if (format == DumpFormat::csv) return write_track_table(run, out);
   const RunHeader& h = run.header();
   const bool lammps = format == DumpFormat::lammps;
   if (lammps) check_lammps_ids(h.id, out);

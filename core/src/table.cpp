@@ -111,17 +111,19 @@ void write_csv(const Table& table, const std::filesystem::path& path,
   file.commit();
 }
 
-void write_csv(const Table& table, AtomicFile& file, const std::vector<std::string>& comment) {
-  const std::filesystem::path& path = file.target();
-  std::ofstream out(file.temp_path(), std::ios::binary);
-  if (!out) throw Error(path.string() + ": cannot open for writing");
+std::string csv_header(const Table& table, const std::vector<std::string>& comment) {
   std::string text;
   for (const std::string& line : comment)
     text += "# " + line + "\n";
   const auto& cols = table.columns();
   for (std::size_t c = 0; c < cols.size(); ++c)
     text += (c ? "," : "") + cols[c].name;
-  text += '\n';
+  return text + '\n';
+}
+
+void write_csv_rows(const Table& table, std::ostream& out) {
+  const auto& cols = table.columns();
+  std::string text;
   for (std::size_t r = 0; r < table.rows(); ++r) {
     for (std::size_t c = 0; c < cols.size(); ++c) {
       if (c) text += ',';
@@ -134,6 +136,14 @@ void write_csv(const Table& table, AtomicFile& file, const std::vector<std::stri
     }
   }
   out << text;
+}
+
+void write_csv(const Table& table, AtomicFile& file, const std::vector<std::string>& comment) {
+  const std::filesystem::path& path = file.target();
+  std::ofstream out(file.temp_path(), std::ios::binary);
+  if (!out) throw Error(path.string() + ": cannot open for writing");
+  out << csv_header(table, comment);
+  write_csv_rows(table, out);
   out.close();
   if (!out) throw Error(path.string() + ": write failed (disk full?)");
 }

@@ -92,4 +92,11 @@ FrameMotion grain_motion(const RunHeader& header, const Frame& before, const Fra
   return m;
 }
 
+HoleContactPolicy hole_contact_policy(const std::string& text, const std::string& option) {
+  if (text == "keep") return HoleContactPolicy::keep;
+  if (text == "exclude-rotations") return HoleContactPolicy::exclude_rotations;
+  if (text == "exclude") return HoleContactPolicy::exclude;
+  throw Error(option + " '" + text + "': expected keep, exclude-rotations or exclude");
+}
+
 }  // namespace granmem

@@ -284,5 +284,33 @@ TEST_F(GranmemTest, ExportExtendedXyz) {
   EXPECT_EQ(lines[13], "30 7 8 9.5 nan 0 -1 0 1");
 }
 
+// trackpy's long table: a row per grain seen, and `import` reads it back to the same run.
+TEST_F(GranmemTest, ExportCsvIsTheTrackTableImportReadsBack) {
+  write_text(in_work("t.csv"), kExportTable);
+  granmem_ok({"import", "t.csv", "--out", "run.h5", "--length-unit", "mm"});
+  EXPECT_EQ(granmem_ok({"export", "run.h5", "--out", "tracks.csv"}).out,
+            "wrote tracks.csv (csv, 3 frames)\n");
+  std::vector<std::string> lines;
+  std::istringstream s(read_text(in_work("tracks.csv")));
+  for (std::string line; std::getline(s, line);)
+    lines.push_back(line);
+  ASSERT_EQ(lines.size(), 2u + 8u);  // comment, names, 3 + 2 + 3 grains seen
+  EXPECT_EQ(lines[1], "frame,particle,time,x,y,z,radius,ax,ay,az,hole_contact");
+  EXPECT_EQ(lines[2], "0,10,0,1,2,3,0.5,0,0,1,0");
+  EXPECT_EQ(lines[9], "2,30,2,7,8,9.5,nan,0,-1,0,1");
+
+  granmem_ok({"import", "tracks.csv", "--out", "again.h5", "--length-unit", "mm"});
+  const h5::File a = h5::File::open(in_work("run.h5")), b = h5::File::open(in_work("again.h5"));
+  for (const char* d : {"/particles/grains/id", "/particles/grains/position/step"})
+    EXPECT_EQ(h5::read<std::int64_t>(a, d), h5::read<std::int64_t>(b, d)) << d;
+  for (const char* d : {"/particles/grains/position/value", "/particles/grains/axis/value",
+                        "/particles/grains/radius"}) {
+    const std::vector<double> x = h5::read<double>(a, d), y = h5::read<double>(b, d);
+    ASSERT_EQ(x.size(), y.size()) << d;
+    for (std::size_t k = 0; k < x.size(); ++k)
+      EXPECT_TRUE(x[k] == y[k] || (std::isnan(x[k]) && std::isnan(y[k]))) << d << " " << k;
+  }
+}
+
 }  // namespace
 }  // namespace granmem::testing

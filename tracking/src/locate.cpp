@@ -8,6 +8,7 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
+#include "granmem/core/units.hpp"
 #include "granmem/rotation/hole_contacts.hpp"
 #include "granmem/tracking/candidates.hpp"
 #include "granmem/tracking/grain_fit.hpp"
@@ -152,7 +153,22 @@ void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reac
 
 }  // namespace
 
+void LocateOptions::validate() const {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw Error("locate: " + what);
+  };
+  require(std::isfinite(diameter) && diameter > 0, "the grain diameter must be positive");
+  require(hole_fraction >= 0 && hole_fraction <= 0.8, "hole_fraction must be in [0, 0.8]");
+  require(beam_axis == 0 || beam_axis == 1, "the beam runs along x (0) or y (1)");
+  require(max_axis_sigma_degrees > 0, "max_axis_sigma_degrees must be positive");
+  require(min_contrast >= 0 && min_contrast < 1, "min_contrast must be in [0, 1)");
+  require(radius_tolerance > 0 && radius_tolerance < 1, "radius_tolerance must be in (0, 1)");
+  require(passes >= 1 && passes <= 10, "passes must be 1 to 10");
+  require(search_rounds >= 0, "search_rounds must be 0 or more");
+}
+
 Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) {
+  o.validate();
   auto clock = std::chrono::steady_clock::now();
   auto lap = [&clock] {
     const auto now = std::chrono::steady_clock::now();
@@ -464,6 +480,22 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
   sum.seconds = sum.seconds_illumination + sum.seconds_candidates + sum.seconds_fits + lap();
   if (summary) *summary = sum;
   return d;
+}
+
+double diameter_in_voxels(const std::string& text, const Stack& stack, const std::string& what) {
+  const Quantity q = parse_quantity(text, what);
+  if (!std::isfinite(q.value) || !(q.value > 0)) {
+    throw Error(what + " '" + text + "': expected a positive diameter");
+  }
+  if (q.unit.empty() || q.unit == "vox" || q.unit == "voxel" || q.unit == "px") return q.value;
+  if (!is_physical_length_unit(q.unit)) {
+    throw Error(what + " '" + text + "': unknown unit " + q.unit + " (m, cm, mm, um, vox)");
+  }
+  if (!stack.voxel_size) {
+    throw Error(what + " '" + text + "': " + stack.source +
+                " has no voxel size: give the diameter in voxels, or --voxel-size");
+  }
+  return convert_length(q.value, q.unit, stack.unit) / stack.voxel_size->x();
 }
 
 }  // namespace granmem

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "granmem/core/table.hpp"
 #include "granmem/core/trajectories.hpp"
 
 namespace granmem {
@@ -41,5 +42,9 @@ struct ImportSummary {
 // frame gets NaN. Throws Error naming file, line and column for bad rows.
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary = nullptr);
+// The same from a table in memory (a pandas DataFrame's columns); `source` names it in
+// messages, its rows counted from 1.
+Trajectories import_table(const Table& table, const std::string& source,
+                          const ImportOptions& options, ImportSummary* summary = nullptr);
 
 }  // namespace granmem

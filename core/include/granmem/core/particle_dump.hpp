@@ -6,13 +6,17 @@
 
 namespace granmem {
 
-// Text formats OVITO (and ASE, VMD) read; OVITO cannot read H5MD.
+// Text formats OVITO (and ASE, VMD) read, OVITO cannot read H5MD, and the long table
+// analysis scripts read.
 enum class DumpFormat {
   // LAMMPS text dump, as `read_dump` and OVITO read it: id type x y z radius [ax ay az]
   // [quatw quati quatj quatk] [hole_contact], where id is the granmem id + 1 (LAMMPS
   // numbers atoms from 1) and type is 1.
   lammps,
   extxyz,  // extended XYZ with the same per-grain properties
+  // trackpy's long table as CSV: frame, particle, time, x, y, z, radius, ... (the columns
+  // of trajectory_table.hpp), for pandas, MATLAB and TrackMate users.
+  csv,
 };
 
 // Writes every frame of a run, grains not seen in a frame left out of it (both formats

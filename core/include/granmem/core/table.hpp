@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <deque>
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -44,6 +45,10 @@ void write_csv(const Table& table, const std::filesystem::path& path,
 // The same into `file`'s temporary, for outputs committed together; messages name its
 // target.
 void write_csv(const Table& table, AtomicFile& file, const std::vector<std::string>& comment = {});
+// The pieces of write_csv for a table written in parts (frame by frame): the comment lines
+// and the column names, then the rows.
+std::string csv_header(const Table& table, const std::vector<std::string>& comment = {});
+void write_csv_rows(const Table& table, std::ostream& out);
 
 // A numeric CSV read for some of its columns, with the file line of each row for messages.
 struct CsvColumns {

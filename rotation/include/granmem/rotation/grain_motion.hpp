@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "granmem/core/trajectories.hpp"
@@ -13,6 +14,8 @@ namespace granmem {
 // neighbour, so the paper drops them from the experimental rotation statistics (their
 // translations are unaffected).
 enum class HoleContactPolicy { keep, exclude_rotations, exclude };
+// "keep", "exclude-rotations" or "exclude" (Error naming `option` otherwise).
+HoleContactPolicy hole_contact_policy(const std::string& text, const std::string& option);
 
 struct MotionOptions {
   // Remove the rigid drift of the packing: the mean displacement of the analysed grains.

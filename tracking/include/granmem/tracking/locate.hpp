@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/stack.hpp"
@@ -27,6 +28,9 @@ struct LocateOptions {
   // Searches of what the found grains leave unexplained, for grains the candidates missed;
   // each is followed by a pass over the new grains and their neighbours.
   int search_rounds = 4;
+
+  // Throws Error naming the first option out of its range (locate() calls it first).
+  void validate() const;
 };
 
 struct LocateSummary {
@@ -46,5 +50,9 @@ struct LocateSummary {
 // (hole_contacts.hpp). `stack` is normalised in place (illumination.hpp). Positions, radii in the
 // stack's unit when it has a voxel size, else in voxels; anisotropic voxels handled throughout.
 Detections locate(Stack& stack, const LocateOptions& options, LocateSummary* summary = nullptr);
+
+// The grain diameter in voxels along x from "12", "12 vox" (or px), or a length ("1.5mm")
+// with the stack's voxel size; Error naming `what` (the option) otherwise.
+double diameter_in_voxels(const std::string& text, const Stack& stack, const std::string& what);
 
 }  // namespace granmem

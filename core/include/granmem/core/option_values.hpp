@@ -8,8 +8,8 @@
 
 #include "granmem/core/trajectories.hpp"
 
-// Parsers for option values that CLI11 passes through as text.
-namespace granmem::app {
+// Parsers for option values given as text (the command line, TOML, Python keywords).
+namespace granmem {
 
 // "xmin,ymin,zmin,xmax,ymax,zmax" -> Box.
 Box parse_box(const std::string& text, const std::string& option, const std::string& run_unit = "");
@@ -22,6 +22,11 @@ std::pair<double, double> parse_range(const std::string& text, const std::string
 double parse_length(const std::string& text, const std::string& run_unit,
                     const std::string& option);
 
+// "LX,LY,LZ<unit>" -> three positive edges (a container's) in `unit`; Error without a
+// length unit.
+Eigen::Vector3d parse_edges(const std::string& text, const std::string& unit,
+                            const std::string& option);
+
 // "X[,Y,Z][ unit]" -> a voxel size (one size: cubic voxels), positive, with the unit as
 // given (empty when none).
 struct VoxelSize {
@@ -33,4 +38,4 @@ VoxelSize parse_voxel_size(const std::string& text, const std::string& option);
 // A time left, as a person reads it: "4m05s", "2h10m".
 std::string duration_text(double seconds);
 
-}  // namespace granmem::app
+}  // namespace granmem

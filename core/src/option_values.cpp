@@ -1,4 +1,4 @@
-#include "parse.hpp"
+#include "granmem/core/option_values.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -6,7 +6,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
 
-namespace granmem::app {
+namespace granmem {
 namespace {
 
 std::pair<std::string, std::string> split_colon(const std::string& text,
@@ -79,6 +79,23 @@ double parse_length(const std::string& text, const std::string& run_unit,
   return convert_length(q.value, q.unit, run_unit);
 }
 
+// "LX,LY,LZ<unit>" -> the edges in `unit` (Error without a length unit or a positive edge).
+Eigen::Vector3d parse_edges(const std::string& text, const std::string& unit,
+                            const std::string& option) {
+  const std::vector<Quantity> v = parse_quantity_list(text, option);
+  if (v.size() != 3 || !is_physical_length_unit(v.back().unit)) {
+    throw Error(option + " '" + text + "': expected LX,LY,LZ with a length unit, e.g. 5,5,7cm");
+  }
+  Eigen::Vector3d edges;
+  for (int a = 0; a < 3; ++a) {
+    edges[a] = convert_length(v[std::size_t(a)].value, v.back().unit, unit);
+    if (!(edges[a] > 0) || !std::isfinite(edges[a])) {
+      throw Error(option + " '" + text + "': each edge must be positive");
+    }
+  }
+  return edges;
+}
+
 VoxelSize parse_voxel_size(const std::string& text, const std::string& option) {
   const std::vector<Quantity> v = parse_quantity_list(text, option);
   if (v.size() != 1 && v.size() != 3) {
@@ -106,4 +123,4 @@ std::string duration_text(double seconds) {
   return buf;
 }
 
-}  // namespace granmem::app
+}  // namespace granmem

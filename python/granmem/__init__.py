@@ -1,0 +1,217 @@
+"""granmem from Python: scans to grains to tracks to displacements, with numpy and pandas.
+
+Stacks are numpy arrays (z, y, x) of uint8 or uint16 with a voxel size (x, y, z) and its
+unit; grains, tracks and displacements are pandas DataFrames with trackpy's column names
+(frame, particle, x, y, z, ...), lengths in ``df.attrs["length_unit"]``. Lengths given as
+options may carry a unit as text ("0.4mm"); a bare number is in the data's unit. The work
+is done by granmem's C++ libraries, the same code as the ``granmem`` command line.
+
+    import granmem
+    stack, voxel_size, unit = granmem.read_stack("scan0.tif")
+    grains = granmem.locate(stack, diameter="5mm", voxel_size=voxel_size, unit=unit)
+    tracks = granmem.link([grains0, grains1, grains2])
+    moved = granmem.motion(tracks, before=0, after=1, subtract_drift=True)
+"""
+
+import os
+
+import numpy as np
+import pandas as pd
+
+from . import _granmem
+from ._granmem import Error
+
+__version__ = _granmem.__version__
+
+__all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
+           "read_tracks", "write_run", "motion", "analyze"]
+
+
+def _frame(columns, units=None, **attrs):
+    df = pd.DataFrame(columns)
+    df.attrs.update(attrs)
+    if units is not None:
+        df.attrs["units"] = {k: v for k, v in units.items() if v}
+    return df
+
+
+def _columns(df, names=None):
+    """A DataFrame's numeric columns as a dict of float arrays (what the libraries read)."""
+    names = df.columns if names is None else [c for c in names if c in df.columns]
+    return {str(c): np.asarray(df[c], dtype=float) for c in names}
+
+
+def _length(value):
+    return value if isinstance(value, str) else repr(float(value))
+
+
+def _vector3(value):
+    if value is None:
+        return None
+    v = np.broadcast_to(np.asarray(value, dtype=float), (3,))
+    return tuple(float(x) for x in v)
+
+
+def read_stack(path, dataset=""):
+    """Reads a scan (multi-page TIFF, folder of slices, or HDF5 ``dataset``).
+
+    Returns ``(stack, voxel_size, unit)``: the (z, y, x) array, the voxel size (x, y, z) or
+    None when the file does not say, and its unit."""
+    return _granmem.read_stack(os.fspath(path), dataset)
+
+
+def write_tiff(stack, path, voxel_size=None, unit=""):
+    """Writes a (z, y, x) uint8/uint16 array as a multi-page TIFF with ImageJ's voxel size."""
+    _granmem.write_tiff(stack, os.fspath(path), _vector3(voxel_size), unit)
+
+
+def render(grains, length_unit="m", diameter_px=20, slice_spacing_ratio=1, clean=False,
+           hole_fraction=0.3, polarity="dark", bits=8, seed=1, frame=0):
+    """Renders a laser-sheet scan of grains (a DataFrame with x, y, z, radius and optionally
+    particle, ax, ay, az), as ``granmem render`` does.
+
+    Returns ``(stack, voxel_size, truth)``: the (z, y, x) array, its voxel size (x, y, z) in
+    ``length_unit`` and the truth (voxel coordinates) as a DataFrame. ``clean`` leaves out
+    the blur, the uneven light and the noise."""
+    stack, voxel_size, truth = _granmem.render(
+        _columns(grains, ["particle", "x", "y", "z", "radius", "ax", "ay", "az"]),
+        length_unit, float(diameter_px), float(slice_spacing_ratio), bool(clean),
+        float(hole_fraction), polarity, int(bits), int(seed), int(frame))
+    return stack, voxel_size, _frame(truth, length_unit="voxel")
+
+
+def locate(stack, diameter, voxel_size=None, unit="", frame=0, polarity="dark",
+           hole_fraction=0.3, beam="x", axis="fit", passes=4, illumination=True):
+    """Every grain of one scan: centre, radius, hole axis and quality, as ``granmem locate``.
+
+    ``stack`` is a (z, y, x) uint8/uint16 array (left unchanged); ``diameter`` in voxels
+    along x (12) or a length ("5mm") with ``voxel_size`` (x, y, z) in ``unit``. Returns a
+    DataFrame: frame, particle (the detection's index), x, y, z, radius, quality, edge, and
+    with holes ax, ay, az, axis_quality, hole_contact; lengths in ``attrs["length_unit"]``
+    (the voxel size's unit, or voxels), the run's numbers in ``attrs["summary"]``."""
+    columns, units, summary = _granmem.locate(
+        stack, str(diameter), _vector3(voxel_size), unit, int(frame), polarity,
+        float(hole_fraction), beam, axis, int(passes), bool(illumination))
+    return _frame(columns, units, length_unit=summary["length_unit"],
+                  voxel_size=summary["voxel_size"], summary=summary)
+
+
+def _scans(detections):
+    """A list of per-scan DataFrames, or one DataFrame with a frame column, -> [(columns, frame)]."""
+    if isinstance(detections, pd.DataFrame):
+        if "frame" not in detections.columns:
+            raise Error("link: the detections have no 'frame' column")
+        parts = [g for _, g in detections.groupby("frame", sort=True)]
+    else:
+        parts = list(detections)
+    scans = []
+    for k, df in enumerate(parts):
+        frame = int(df["frame"].iloc[0]) if "frame" in df.columns and len(df) else k
+        columns = _columns(df, ["x", "y", "z", "radius", "quality", "edge", "ax", "ay", "az",
+                                "axis_quality", "hole_contact"])
+        n = len(df)
+        # trackpy's tables have no radius, quality or edge: unknown, good, inside.
+        columns.setdefault("radius", np.full(n, np.nan))
+        columns.setdefault("quality", np.ones(n))
+        columns.setdefault("edge", np.zeros(n))
+        scans.append((columns, frame))
+    return scans, parts
+
+
+def link(detections, length_unit=None, voxel_size=None, max_displacement="auto", memory=2,
+         drift=True, container=None, container_size=None):
+    """Links the detections of successive scans into tracks, as ``granmem link``.
+
+    ``detections``: a list of DataFrames, one per scan in order (e.g. from ``locate``), or
+    one DataFrame with a frame column (trackpy's shape). Returns the tracks as a DataFrame:
+    frame, particle (the track), time, x, y, z, radius, and ax, ay, az, hole_contact where
+    the scans have axes. ``container`` ("xmin,ymin,zmin,xmax,ymax,zmax cm") or
+    ``container_size`` ("LX,LY,LZ cm", placed at the packing's extent in the first scan)
+    moves the positions into the container's frame."""
+    scans, parts = _scans(detections)
+    if length_unit is None:
+        length_unit = parts[0].attrs.get("length_unit", "voxel") if parts else "voxel"
+    if voxel_size is None and parts:
+        voxel_size = parts[0].attrs.get("voxel_size")
+    columns, units, summary = _granmem.link(
+        scans, length_unit, _vector3(voxel_size), _length(max_displacement) if
+        max_displacement != "auto" else "auto", int(memory), bool(drift), container,
+        container_size)
+    return _frame(columns, units, length_unit=length_unit, summary=summary)
+
+
+def read_run(path):
+    """A trajectory store (.h5, H5MD) as a dict of numpy arrays: position (frames, grains,
+    3; NaN where not seen), axis, orientation (or None), id, radius, step, time, box,
+    length_unit, time_unit, parameters, and observables (name -> unit, step, time, value)."""
+    return _granmem.read_run(os.fspath(path))
+
+
+def read_tracks(path):
+    """A trajectory store as trackpy's long DataFrame: a row per grain seen in each frame."""
+    columns, units = _granmem.track_table(os.fspath(path))
+    run_unit = units.get("x", "")
+    return _frame(columns, units, length_unit=run_unit)
+
+
+def write_run(tracks, path, length_unit=None, radius=None):
+    """Writes tracks (frame, particle, x, y, z and optionally radius, ax, ay, az,
+    hole_contact) as a trajectory store that ``granmem analyze``, ``compare`` and
+    ``calibrate`` read; written atomically. ``radius``: of every grain, for tables without
+    a radius column."""
+    unit = length_unit or tracks.attrs.get("length_unit", "voxel")
+    names = ["frame", "particle", "x", "y", "z", "radius", "ax", "ay", "az", "hole_contact"]
+    _granmem.write_run(_columns(tracks, names), os.fspath(path), unit,
+                       None if radius is None else float(radius))
+
+
+def motion(run, before, after, subtract_drift=False, wall_distance=0,
+           hole_contacts="keep", length_unit=None):
+    """How each grain moved from frame ``before`` to frame ``after`` (frame labels), as
+    ``granmem analyze`` measures it: particle, dx, dy, dz, dr, and with axes or
+    orientations theta_axis (rad), rot_disp, theta_full (rad).
+
+    ``run``: a trajectory store's path, or tracks as a DataFrame. ``wall_distance`` leaves
+    out grains that near a face of the run's box; ``hole_contacts``: keep,
+    exclude-rotations (the paper's choice for scans) or exclude. The removed drift is in
+    ``attrs["drift"]``."""
+    if isinstance(run, pd.DataFrame):
+        unit = length_unit or run.attrs.get("length_unit", "voxel")
+        names = ["frame", "particle", "x", "y", "z", "radius", "ax", "ay", "az", "hole_contact"]
+        out = _granmem.motion_of_table(_columns(run, names), unit, int(before), int(after),
+                                       bool(subtract_drift), _length(wall_distance),
+                                       hole_contacts)
+    else:
+        out = _granmem.motion_of_run(os.fspath(run), int(before), int(after),
+                                     bool(subtract_drift), _length(wall_distance),
+                                     hole_contacts)
+        unit = out["units"].get("dx", "")
+    return _frame(out["columns"], out["units"], length_unit=unit, drift=out["drift"])
+
+
+def _range(value):
+    if value is None or isinstance(value, str):
+        return value
+    lo, hi = value
+    return f"{lo}:{hi}"
+
+
+def analyze(run, subtract_drift=False, wall_distance=0, box=None, hole_contacts="keep",
+            pdf=(), pdf_frames=None, pdf_bins=50, pdf_scale="linear", pdf_range=None):
+    """The paper's statistics of a run between consecutive frames, as ``granmem analyze``
+    (the same tables as its CSV files), for a trajectory store's path.
+
+    Returns a dict: ``displacements`` (a row per grain per frame pair), ``per_frame``
+    (means, medians, MSD, drift, packing fraction, coordination), ``pdfs`` (quantity ->
+    DataFrame of bins) as DataFrames, and ``notes`` (what was left out and why).
+    ``pdf_frames`` and ``pdf_range`` as ``(lo, hi)`` or "lo:hi"; ``box`` as
+    "xmin,ymin,zmin,xmax,ymax,zmax"."""
+    out = _granmem.analyze(os.fspath(run), bool(subtract_drift), _length(wall_distance), box,
+                           hole_contacts, list(pdf), _range(pdf_frames), int(pdf_bins),
+                           pdf_scale, _range(pdf_range))
+    unit = out["length_unit"]
+    tables = {name: _frame(*out[name], length_unit=unit) for name in ("displacements",
+                                                                       "per_frame")}
+    tables["pdfs"] = {q: _frame(*t, length_unit=unit) for q, t in out["pdfs"].items()}
+    tables["notes"] = out["notes"]
+    return tables

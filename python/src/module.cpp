@@ -1,0 +1,574 @@
+// granmem._granmem: the libraries' entry points with numpy in and out. Tables cross as
+// dicts of 1-D arrays (column name -> values) that granmem/__init__.py turns into pandas
+// DataFrames; stacks as (z, y, x) arrays; options as keywords with the CLI's names, lengths
+// as numbers or as text with a unit ("0.4mm"). Long calls release the GIL.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/import_table.hpp"
+#include "granmem/core/option_values.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/core/trajectory_table.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/core/version.hpp"
+#include "granmem/rotation/grain_motion.hpp"
+#include "granmem/rotation/motion_analysis.hpp"
+#include "granmem/tracking/detections.hpp"
+#include "granmem/tracking/link.hpp"
+#include "granmem/tracking/locate.hpp"
+#include "granmem/tracking/render.hpp"
+#include "granmem/tracking/stack.hpp"
+
+namespace py = pybind11;
+
+namespace granmem::python {
+namespace {
+
+using Vector3 = std::array<double, 3>;
+
+Eigen::Vector3d vector_of(const Vector3& v) {
+  return {v[0], v[1], v[2]};
+}
+
+py::object optional_vector(const std::optional<Eigen::Vector3d>& v) {
+  if (!v) return py::none();
+  return py::make_tuple((*v)[0], (*v)[1], (*v)[2]);
+}
+
+// ------------------------------------------------------------------------------ tables
+
+// Integer columns (frame, particle, flags) as int64, the rest as float64.
+py::dict columns_of(const Table& table) {
+  py::dict out;
+  for (const Column& c : table.columns()) {
+    const auto n = py::ssize_t(c.values.size());
+    if (c.integer) {
+      py::array_t<std::int64_t> a(n);
+      std::int64_t* p = a.mutable_data();
+      for (py::ssize_t i = 0; i < n; ++i)
+        p[i] = std::int64_t(c.values[std::size_t(i)]);
+      out[py::str(c.name)] = a;
+    } else {
+      py::array_t<double> a(n);
+      std::copy(c.values.begin(), c.values.end(), a.mutable_data());
+      out[py::str(c.name)] = a;
+    }
+  }
+  return out;
+}
+
+py::dict units_of(const Table& table) {
+  py::dict out;
+  for (const Column& c : table.columns())
+    out[py::str(c.name)] = c.unit;
+  return out;
+}
+
+// A dict of equal-length 1-D columns (numbers) -> a Table; `length_unit` for x, y, z, radius.
+Table table_of(const py::dict& columns, const std::string& length_unit, const std::string& what) {
+  Table t;
+  std::size_t rows = 0;
+  bool first = true;
+  for (const auto& [key, value] : columns) {
+    const std::string name = py::str(key);
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+    if (!a || a.ndim() != 1) throw Error(what + ": column '" + name + "' is not 1-D numbers");
+    if (!first && std::size_t(a.size()) != rows) {
+      throw Error(what + ": column '" + name + "' has " + std::to_string(a.size()) +
+                  " rows, the others " + std::to_string(rows));
+    }
+    rows = std::size_t(a.size());
+    first = false;
+    const bool is_length = name == "x" || name == "y" || name == "z" || name == "radius";
+    const bool integer =
+        name == "frame" || name == "particle" || name == "edge" || name == "hole_contact";
+    Column& c = t.add(name, is_length ? length_unit : "", integer);
+    c.values.assign(a.data(), a.data() + a.size());
+  }
+  return t;
+}
+
+py::tuple table_result(const Table& table) {
+  return py::make_tuple(columns_of(table), units_of(table));
+}
+
+// ------------------------------------------------------------------------------ stacks
+
+Stack stack_of(const py::array& array, const std::optional<Vector3>& voxel_size,
+               const std::string& unit) {
+  if (array.ndim() != 3) {
+    throw Error("stack: expected a 3-D array (z, y, x), got " + std::to_string(array.ndim()) +
+                " dimensions");
+  }
+  const bool bits8 = py::isinstance<py::array_t<std::uint8_t>>(array);
+  if (!bits8 && !py::isinstance<py::array_t<std::uint16_t>>(array)) {
+    throw Error("stack: expected a uint8 or uint16 array, got " +
+                std::string(py::str(array.dtype())));
+  }
+  Stack s(array.shape(2), array.shape(1), array.shape(0), bits8 ? 8 : 16);
+  s.source = "stack";
+  if (bits8) {
+    const auto a = py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>(array);
+    std::copy(a.data(), a.data() + a.size(), s.voxels.begin());
+  } else {
+    const auto a = py::array_t<std::uint16_t, py::array::c_style | py::array::forcecast>(array);
+    std::copy(a.data(), a.data() + a.size(), s.voxels.begin());
+  }
+  if (voxel_size) {
+    if (!is_physical_length_unit(unit)) {
+      throw Error("voxel_size needs a unit (m, cm, mm, um), e.g. unit='mm'");
+    }
+    s.voxel_size = vector_of(*voxel_size);
+    if (!(s.voxel_size->array() > 0).all() || !s.voxel_size->allFinite()) {
+      throw Error("voxel_size: expected three positive sizes");
+    }
+    s.unit = unit;
+  }
+  return s;
+}
+
+py::array array_of(const Stack& s) {
+  const std::vector<py::ssize_t> shape{s.nz, s.ny, s.nx};
+  if (s.bits == 8) {
+    py::array_t<std::uint8_t> a(shape);
+    std::transform(s.voxels.begin(), s.voxels.end(), a.mutable_data(),
+                   [](std::uint16_t v) { return std::uint8_t(v); });
+    return std::move(a);
+  }
+  py::array_t<std::uint16_t> a(shape);
+  std::copy(s.voxels.begin(), s.voxels.end(), a.mutable_data());
+  return std::move(a);
+}
+
+py::tuple read_stack_py(const std::filesystem::path& path, const std::string& dataset) {
+  StackReadOptions options;
+  options.dataset = dataset;
+  Stack s;
+  {
+    py::gil_scoped_release release;
+    s = read_stack(path, options);
+  }
+  return py::make_tuple(array_of(s), optional_vector(s.voxel_size), s.unit);
+}
+
+void write_tiff_py(const py::array& array, const std::filesystem::path& path,
+                   const std::optional<Vector3>& voxel_size, const std::string& unit) {
+  const Stack s = stack_of(array, voxel_size, unit);
+  py::gil_scoped_release release;
+  write_tiff(s, path);
+}
+
+// ------------------------------------------------------------------------------ locate
+
+LocateOptions locate_options(const Stack& stack, const std::string& diameter,
+                             const std::string& polarity, double hole_fraction,
+                             const std::string& beam, const std::string& axis, int passes,
+                             bool illumination) {
+  if (polarity != "dark" && polarity != "bright") {
+    throw Error("polarity '" + polarity + "': expected 'dark' or 'bright'");
+  }
+  if (beam != "x" && beam != "y") throw Error("beam '" + beam + "': expected 'x' or 'y'");
+  if (axis != "fit" && axis != "lab") throw Error("axis '" + axis + "': expected 'fit' or 'lab'");
+  LocateOptions o;
+  o.diameter = diameter_in_voxels(diameter, stack, "diameter");
+  o.dark_grains = polarity == "dark";
+  o.hole_fraction = o.dark_grains ? hole_fraction : 0.0;
+  o.beam_axis = beam == "y" ? 1 : 0;
+  o.fit_axis = axis == "fit";
+  o.passes = passes;
+  o.correct_illumination = illumination;
+  o.validate();
+  return o;
+}
+
+py::tuple locate_py(const py::array& array, const std::string& diameter,
+                    const std::optional<Vector3>& voxel_size, const std::string& unit,
+                    std::int64_t frame, const std::string& polarity, double hole_fraction,
+                    const std::string& beam, const std::string& axis, int passes,
+                    bool illumination) {
+  Stack stack = stack_of(array, voxel_size, unit);  // a copy: the caller's array stays as it is
+  const LocateOptions o =
+      locate_options(stack, diameter, polarity, hole_fraction, beam, axis, passes, illumination);
+  LocateSummary sum;
+  Detections d;
+  {
+    py::gil_scoped_release release;
+    d = locate(stack, o, &sum);
+  }
+  d.frame = frame;
+  py::dict summary;
+  summary["candidates"] = sum.candidates;
+  summary["located"] = sum.located;
+  summary["rejected"] = sum.rejected;
+  summary["on_edge"] = sum.on_edge;
+  summary["seconds"] = sum.seconds;
+  summary["length_unit"] = d.length_unit;
+  summary["voxel_size"] = optional_vector(d.voxel_size);
+  const Table t = to_table(d);
+  return py::make_tuple(columns_of(t), units_of(t), summary);
+}
+
+// ------------------------------------------------------------------------------ render
+
+std::vector<RenderedGrain> grains_of(const py::dict& columns, const std::string& length_unit) {
+  const Table t = table_of(columns, length_unit, "grains");
+  for (const char* c : {"x", "y", "z", "radius"}) {
+    if (!t.has(c)) throw Error(std::string("grains: no column '") + c + "'");
+  }
+  const bool axis = t.has("ax") && t.has("ay") && t.has("az");
+  std::vector<RenderedGrain> grains(t.rows());
+  for (std::size_t i = 0; i < grains.size(); ++i) {
+    RenderedGrain& g = grains[i];
+    g.id = t.has("particle") ? std::int64_t(t["particle"].values[i]) : std::int64_t(i);
+    g.centre = {t["x"].values[i], t["y"].values[i], t["z"].values[i]};
+    g.radius = t["radius"].values[i];
+    if (axis) g.axis = {t["ax"].values[i], t["ay"].values[i], t["az"].values[i]};
+  }
+  return grains;
+}
+
+py::tuple render_py(const py::dict& grains, const std::string& length_unit, double diameter_px,
+                    double slice_spacing_ratio, bool clean, double hole_fraction,
+                    const std::string& polarity, int bits, std::uint64_t seed, std::int64_t frame) {
+  if (polarity != "dark" && polarity != "bright") {
+    throw Error("polarity '" + polarity + "': expected 'dark' or 'bright'");
+  }
+  RenderOptions o;
+  o.length_unit = length_unit;
+  o.diameter_px = diameter_px;
+  o.slice_spacing_ratio = slice_spacing_ratio;
+  o.hole_fraction = hole_fraction;
+  o.polarity = polarity == "dark" ? Polarity::dark_grains : Polarity::bright_grains;
+  o.bits = bits;
+  o.seed = seed;
+  o.frame = frame;
+  if (clean) o = o.without_artefacts();
+  const std::vector<RenderedGrain> drawn = grains_of(grains, length_unit);
+  Table truth;
+  Stack s;
+  {
+    py::gil_scoped_release release;
+    s = render_scan(drawn, o, &truth);
+  }
+  return py::make_tuple(array_of(s), optional_vector(s.voxel_size), columns_of(truth));
+}
+
+// ------------------------------------------------------------------------------ runs
+
+// A run as arrays: frames x grains x 3 positions (NaN: not seen), the header's fields, the
+// observables.
+py::dict run_arrays(const Trajectories& run) {
+  const RunHeader& h = run.header;
+  const auto frames = py::ssize_t(run.frames.size()), n = py::ssize_t(h.grain_count());
+  auto stacked = [&](auto field, py::ssize_t width) {
+    py::array_t<double> a(std::vector<py::ssize_t>{frames, n, width});
+    double* p = a.mutable_data();
+    for (const Frame& f : run.frames) {
+      const auto& m = field(f);
+      p = std::copy(m.data(), m.data() + m.size(), p);
+    }
+    return a;
+  };
+  py::dict out;
+  out["length_unit"] = h.length_unit;
+  out["time_unit"] = h.time_unit;
+  out["sample"] = h.sample;
+  out["id"] = py::array_t<std::int64_t>(n, h.id.data());
+  out["radius"] = py::array_t<double>(n, h.radius.data());
+  out["box"] =
+      h.box
+          ? py::object(py::make_tuple(optional_vector(h.box->lower), optional_vector(h.box->edges)))
+          : py::object(py::none());
+  out["voxel_size"] = optional_vector(h.voxel_size);
+  std::vector<std::int64_t> step;
+  std::vector<double> time;
+  for (const Frame& f : run.frames) {
+    step.push_back(f.step);
+    time.push_back(f.time);
+  }
+  out["step"] = py::array_t<std::int64_t>(frames, step.data());
+  out["time"] = py::array_t<double>(frames, time.data());
+  out["position"] = stacked([](const Frame& f) -> const Vectors3& { return f.position; }, 3);
+  out["axis"] =
+      h.has_axis ? py::object(stacked([](const Frame& f) -> const Vectors3& { return f.axis; }, 3))
+                 : py::object(py::none());
+  out["orientation"] =
+      h.has_orientation
+          ? py::object(
+                stacked([](const Frame& f) -> const Quaternions& { return f.orientation; }, 4))
+          : py::object(py::none());
+  py::dict observables;
+  for (const auto& [name, o] : run.observables) {
+    py::dict d;
+    d["unit"] = o.unit;
+    d["step"] = py::array_t<std::int64_t>(py::ssize_t(o.step.size()), o.step.data());
+    d["time"] = py::array_t<double>(py::ssize_t(o.time.size()), o.time.data());
+    d["value"] = py::array_t<double>(py::ssize_t(o.value.size()), o.value.data());
+    observables[py::str(name)] = d;
+  }
+  out["observables"] = observables;
+  out["parameters"] = h.parameters;
+  return out;
+}
+
+Trajectories read_run(const std::filesystem::path& path) {
+  py::gil_scoped_release release;
+  return read_trajectories(path);
+}
+
+ImportOptions import_options(const std::string& length_unit, const std::optional<double>& radius) {
+  ImportOptions o;
+  o.length_unit = length_unit;
+  o.radius = radius;
+  return o;
+}
+
+Trajectories run_of_table(const py::dict& columns, const std::string& length_unit,
+                          const std::optional<double>& radius) {
+  return import_table(table_of(columns, length_unit, "tracks"), "tracks",
+                      import_options(length_unit, radius));
+}
+
+void write_run_py(const py::dict& columns, const std::filesystem::path& path,
+                  const std::string& length_unit, const std::optional<double>& radius) {
+  const Trajectories run = run_of_table(columns, length_unit, radius);
+  py::gil_scoped_release release;
+  write_trajectories(path, run);
+}
+
+// ------------------------------------------------------------------------------ link
+
+// One scan's detections: its columns and frame; all in `length_unit`.
+Detections detections_of(const py::dict& columns, std::int64_t frame,
+                         const std::string& length_unit, const std::optional<Vector3>& voxel_size) {
+  const std::string where = "frame " + std::to_string(frame);
+  Detections d = from_table(table_of(columns, length_unit, where), where);
+  d.frame = frame;
+  d.length_unit = length_unit;
+  d.source = where;
+  if (voxel_size) d.voxel_size = vector_of(*voxel_size);
+  return d;
+}
+
+py::tuple link_py(const py::list& scans, const std::string& length_unit,
+                  const std::optional<Vector3>& voxel_size, const std::string& max_displacement,
+                  int memory, bool drift, const std::optional<std::string>& container,
+                  const std::optional<std::string>& container_size) {
+  if (!is_length_unit(length_unit)) {
+    throw Error("length_unit '" + length_unit + "': expected m, cm, mm, um or voxel");
+  }
+  if (memory < 0) throw Error("memory must be 0 or more");
+  if (container && container_size) {
+    throw Error("container and container_size: give the container or its size, not both");
+  }
+  std::vector<Detections> found;
+  for (const py::handle& scan : scans) {
+    const auto pair = scan.cast<py::tuple>();
+    found.push_back(detections_of(pair[0].cast<py::dict>(), pair[1].cast<std::int64_t>(),
+                                  length_unit, voxel_size));
+  }
+  if (found.empty()) throw Error("link: no scans");
+  LinkOptions o;
+  if (max_displacement != "auto") {
+    o.max_displacement = parse_length(max_displacement, length_unit, "max_displacement");
+  }
+  o.memory = memory;
+  o.estimate_drift = o.local_field = drift;
+  LinkSummary sum;
+  Trajectories run;
+  {
+    py::gil_scoped_release release;
+    run = link_scans(found, o, &sum);
+  }
+  if (container) {
+    register_to_container(run, parse_box(*container, "container", length_unit));
+  } else if (container_size) {
+    const Eigen::Vector3d edges = parse_edges(*container_size, length_unit, "container_size");
+    register_to_container(run, container_from_extent(run, edges));
+  }
+  py::list per_scan;
+  for (const ScanLinks& r : sum.scans) {
+    py::dict d;
+    d["frame"] = r.frame;
+    d["detections"] = r.detections;
+    d["linked"] = r.linked;
+    d["relinked"] = r.relinked;
+    d["started"] = r.started;
+    d["lost"] = r.unlinked;
+    d["linked_fraction"] = r.linked_fraction();
+    d["rms_residual"] = r.rms_residual;
+    per_scan.append(d);
+  }
+  py::dict summary;
+  summary["tracks"] = sum.tracks;
+  summary["max_displacement"] = sum.max_displacement;
+  summary["length_unit"] = sum.length_unit;
+  summary["scans"] = per_scan;
+  const Table t = trajectory_table(run);
+  return py::make_tuple(columns_of(t), units_of(t), summary);
+}
+
+// ------------------------------------------------------------------------------ motion
+
+std::size_t frame_index(const Trajectories& run, std::int64_t frame) {
+  for (std::size_t t = 0; t < run.frames.size(); ++t) {
+    if (run.frames[t].step == frame) return t;
+  }
+  throw Error("the run has no frame " + std::to_string(frame));
+}
+
+py::dict motion_of(const Trajectories& run, std::int64_t before, std::int64_t after,
+                   bool subtract_drift, const std::string& wall_distance,
+                   const std::string& hole_contacts) {
+  MotionOptions o;
+  o.subtract_drift = subtract_drift;
+  o.wall_distance = parse_length(wall_distance, run.header.length_unit, "wall_distance");
+  o.hole_contacts = hole_contact_policy(hole_contacts, "hole_contacts");
+  if (o.wall_distance > 0 && !run.header.box) {
+    throw Error("wall_distance: the run has no box (link with a container, or import with one)");
+  }
+  const FrameMotion m = grain_motion(run.header, run.frames[frame_index(run, before)],
+                                     run.frames[frame_index(run, after)], o);
+  const std::string& unit = run.header.length_unit;
+  Table t;
+  Column& particle = t.add("particle", "", true);
+  Column* d[3] = {&t.add("dx", unit), &t.add("dy", unit), &t.add("dz", unit)};
+  for (std::size_t k = 0; k < m.grain.size(); ++k) {
+    particle.values.push_back(double(run.header.id[m.grain[k]]));
+    for (int a = 0; a < 3; ++a)
+      d[a]->values.push_back(m.displacement(Eigen::Index(k), a));
+  }
+  t.add("dr", unit).values = m.dr;
+  if (m.has_rotation) {
+    t.add("theta_axis", "rad").values = m.theta_axis;
+    t.add("rot_disp", unit).values = m.rot_disp;
+  }
+  if (!m.theta_full.empty()) t.add("theta_full", "rad").values = m.theta_full;
+  py::dict out;
+  out["columns"] = columns_of(t);
+  out["units"] = units_of(t);
+  out["drift"] = py::make_tuple(m.drift[0], m.drift[1], m.drift[2]);
+  return out;
+}
+
+// ------------------------------------------------------------------------------ analyze
+
+py::dict analyze_py(const std::filesystem::path& path, bool subtract_drift,
+                    const std::string& wall_distance, const std::optional<std::string>& box,
+                    const std::string& hole_contacts, const std::vector<std::string>& pdf,
+                    const std::optional<std::string>& pdf_frames, std::size_t pdf_bins,
+                    const std::string& pdf_scale, const std::optional<std::string>& pdf_range) {
+  if (pdf_scale != "linear" && pdf_scale != "log") {
+    throw Error("pdf_scale '" + pdf_scale + "': expected linear or log");
+  }
+  const TrajectoryReader run(path);
+  AnalysisOptions o;
+  o.motion.subtract_drift = subtract_drift;
+  o.motion.wall_distance = parse_length(wall_distance, run.header().length_unit, "wall_distance");
+  if (box) o.motion.box = parse_box(*box, "box");
+  o.motion.hole_contacts = hole_contact_policy(hole_contacts, "hole_contacts");
+  o.pdf_quantities = pdf;
+  if (pdf_frames) o.pdf_frames = parse_int_range(*pdf_frames, "pdf_frames");
+  o.density.bins = pdf_bins;
+  o.density.scale = pdf_scale == "log" ? BinScale::logarithmic : BinScale::linear;
+  if (pdf_range) o.density.range = parse_range(*pdf_range, "pdf_range");
+  MotionAnalysis a;
+  {
+    py::gil_scoped_release release;
+    a = analyze_motion(run, o);
+  }
+  py::dict pdfs;
+  for (const auto& [quantity, table] : a.pdfs)
+    pdfs[py::str(quantity)] = table_result(table);
+  py::dict out;
+  out["displacements"] = table_result(a.displacements);
+  out["per_frame"] = table_result(a.per_frame);
+  out["pdfs"] = pdfs;
+  out["length_unit"] = a.length_unit;
+  out["notes"] = a.notes;
+  return out;
+}
+
+}  // namespace
+}  // namespace granmem::python
+
+PYBIND11_MODULE(_granmem, m) {
+  using namespace granmem;
+  using namespace granmem::python;
+  m.doc() = "granmem's libraries: locate, link, render, trajectory stores, grain motion";
+  m.attr("__version__") = granmem::kVersion;
+  static py::exception<Error> error(m, "Error", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      error(e.what());
+    }
+  });
+
+  m.def("read_stack", &read_stack_py, py::arg("path"), py::arg("dataset") = "");
+  m.def("write_tiff", &write_tiff_py, py::arg("stack"), py::arg("path"),
+        py::arg("voxel_size") = py::none(), py::arg("unit") = "");
+  m.def("locate", &locate_py, py::arg("stack"), py::arg("diameter"),
+        py::arg("voxel_size") = py::none(), py::arg("unit") = "", py::arg("frame") = 0,
+        py::arg("polarity") = "dark", py::arg("hole_fraction") = LocateOptions{}.hole_fraction,
+        py::arg("beam") = "x", py::arg("axis") = "fit", py::arg("passes") = LocateOptions{}.passes,
+        py::arg("illumination") = true);
+  m.def("render", &render_py, py::arg("grains"), py::arg("length_unit"),
+        py::arg("diameter_px") = RenderOptions{}.diameter_px,
+        py::arg("slice_spacing_ratio") = RenderOptions{}.slice_spacing_ratio,
+        py::arg("clean") = false, py::arg("hole_fraction") = RenderOptions{}.hole_fraction,
+        py::arg("polarity") = "dark", py::arg("bits") = RenderOptions{}.bits,
+        py::arg("seed") = RenderOptions{}.seed, py::arg("frame") = 0);
+  m.def("link", &link_py, py::arg("scans"), py::arg("length_unit"),
+        py::arg("voxel_size") = py::none(), py::arg("max_displacement") = "auto",
+        py::arg("memory") = LinkOptions{}.memory, py::arg("drift") = true,
+        py::arg("container") = py::none(), py::arg("container_size") = py::none());
+  m.def(
+      "read_run", [](const std::filesystem::path& path) { return run_arrays(read_run(path)); },
+      py::arg("path"));
+  m.def(
+      "track_table",
+      [](const std::filesystem::path& path) {
+        return table_result(trajectory_table(read_run(path)));
+      },
+      py::arg("path"));
+  m.def("write_run", &write_run_py, py::arg("columns"), py::arg("path"), py::arg("length_unit"),
+        py::arg("radius") = py::none());
+  m.def("analyze", &analyze_py, py::arg("path"), py::arg("subtract_drift") = false,
+        py::arg("wall_distance") = "0", py::arg("box") = py::none(),
+        py::arg("hole_contacts") = "keep", py::arg("pdf") = std::vector<std::string>{},
+        py::arg("pdf_frames") = py::none(), py::arg("pdf_bins") = 50,
+        py::arg("pdf_scale") = "linear", py::arg("pdf_range") = py::none());
+  m.def(
+      "motion_of_run",
+      [](const std::filesystem::path& path, std::int64_t before, std::int64_t after,
+         bool subtract_drift, const std::string& wall_distance, const std::string& hole_contacts) {
+        return motion_of(read_run(path), before, after, subtract_drift, wall_distance,
+                         hole_contacts);
+      },
+      py::arg("path"), py::arg("before"), py::arg("after"), py::arg("subtract_drift") = false,
+      py::arg("wall_distance") = "0", py::arg("hole_contacts") = "keep");
+  m.def(
+      "motion_of_table",
+      [](const py::dict& columns, const std::string& length_unit, std::int64_t before,
+         std::int64_t after, bool subtract_drift, const std::string& wall_distance,
+         const std::string& hole_contacts) {
+        return motion_of(run_of_table(columns, length_unit, std::nullopt), before, after,
+                         subtract_drift, wall_distance, hole_contacts);
+      },
+      py::arg("columns"), py::arg("length_unit"), py::arg("before"), py::arg("after"),
+      py::arg("subtract_drift") = false, py::arg("wall_distance") = "0",
+      py::arg("hole_contacts") = "keep");
+}

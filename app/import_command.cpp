@@ -13,15 +13,17 @@ namespace granmem::app {
 
 void add_import(CLI::App& app) {
   struct Args {
-    std::string table, out, length_unit = "voxel", voxel_size, box, sample = kSampleEndOfCycle;
+    std::string table, out, length_unit = "voxel", voxel_size, box, sample = kSampleEndOfCycle,
+                            columns;
     double radius = 0;
+    std::size_t skip_rows = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "import",
       "Read a long-form CSV of tracked grains (frame,particle,x,y,z[,ax,ay,az][,radius]"
       "[,hole_contact]) into a trajectory store");
-  cmd->add_option("table", args->table, "CSV table, one row per grain per frame")
+  cmd->add_option("table", args->table, "CSV (or tab-separated) table, one row per grain per frame")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
@@ -36,6 +38,12 @@ void add_import(CLI::App& app) {
                   "container xmin,ymin,zmin,xmax,ymax,zmax in the table's unit");
   cmd->add_option("--sample", args->sample, "what a frame is")
       ->check(CLI::IsMember({kSampleEndOfCycle, kSampleFullCompression, kSampleInCycle}))
+      ->capture_default_str();
+  cmd->add_option("--columns", args->columns,
+                  "the table's names for granmem's columns, NAME=column,... e.g. TrackMate's "
+                  "FRAME=frame,TRACK_ID=particle,POSITION_X=x,POSITION_Y=y,POSITION_Z=z");
+  cmd->add_option("--skip-rows", args->skip_rows,
+                  "lines after the header that are not data (TrackMate's CSV: 3)")
       ->capture_default_str();
 
   cmd->callback([args, cmd, radius] {
@@ -55,6 +63,8 @@ void add_import(CLI::App& app) {
       options.voxel_size_unit = v[0].unit;
     }
     if (!args->box.empty()) options.box = parse_box(args->box, "--box");
+    options.csv.rename = parse_renames(args->columns, "--columns");
+    options.csv.skip_rows = args->skip_rows;
 
     ImportSummary summary;
     Trajectories run = import_table(args->table, options, &summary);

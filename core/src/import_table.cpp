@@ -244,7 +244,7 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary) {
   scaling_of(options);  // bad options refused before the file is read
-  const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns);
+  const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns, options.csv);
   return import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
 }
 

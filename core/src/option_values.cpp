@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/units.hpp"
@@ -94,6 +95,24 @@ Eigen::Vector3d parse_edges(const std::string& text, const std::string& unit,
     }
   }
   return edges;
+}
+
+std::map<std::string, std::string> parse_renames(const std::string& text,
+                                                 const std::string& option) {
+  std::map<std::string, std::string> out;
+  std::stringstream items(text);
+  for (std::string item; std::getline(items, item, ',');) {
+    const std::size_t eq = item.find('=');
+    const std::string from(trim(item.substr(0, eq)));
+    const std::string to(eq == std::string::npos ? "" : trim(item.substr(eq + 1)));
+    if (from.empty() || to.empty()) {
+      throw Error(option + " '" + text + "': expected NAME=column,... e.g. POSITION_X=x");
+    }
+    if (!out.emplace(from, to).second) {
+      throw Error(option + " '" + text + "': " + from + " is named twice");
+    }
+  }
+  return out;
 }
 
 VoxelSize parse_voxel_size(const std::string& text, const std::string& option) {

@@ -66,27 +66,36 @@ std::string_view trim(std::string_view s) {
 
 // Splits one CSV line on commas; a field in double quotes (RFC 4180) may hold commas and
 // doubled quotes, and is given without its quotes.
-void split(std::string_view line, std::vector<std::string_view>& fields) {
+// Fields between `delimiter`s; a quoted field (RFC 4180) may hold delimiters and is given
+// without its quotes (a doubled quote inside stays doubled).
+void split(std::string_view line, std::vector<std::string_view>& fields, char delimiter) {
   fields.clear();
   std::size_t start = 0;
   while (true) {
     std::size_t text = line.find_first_not_of(" \t", start);
+    std::size_t open = std::string_view::npos, close = std::string_view::npos;
     if (text != std::string_view::npos && line[text] == '"') {
+      open = text;
       for (++text; text < line.size(); ++text) {  // to the closing quote
         if (line[text] != '"') continue;
         if (text + 1 < line.size() && line[text + 1] == '"') {
           ++text;
         } else {
+          close = text;
           break;
         }
       }
     } else {
       text = start;
     }
-    const std::size_t comma = line.find(',', std::min(text, line.size()));
-    fields.push_back(trim(line.substr(start, comma - start)));
-    if (comma == std::string_view::npos) return;
-    start = comma + 1;
+    const std::size_t end = line.find(delimiter, std::min(text, line.size()));
+    std::string_view field = trim(line.substr(start, end - start));
+    if (close != std::string_view::npos && field.size() == close - open + 1) {
+      field = line.substr(open + 1, close - open - 1);
+    }
+    fields.push_back(field);
+    if (end == std::string_view::npos) return;
+    start = end + 1;
   }
 }
 
@@ -149,7 +158,7 @@ void write_csv(const Table& table, AtomicFile& file, const std::vector<std::stri
 }
 
 CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::string>& required,
-                    const std::vector<std::string>& optional) {
+                    const std::vector<std::string>& optional, const CsvReadOptions& options) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw Error(path.string() + ": cannot open for reading");
   const std::string where = path.string();
@@ -174,10 +183,16 @@ CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::st
     break;
   }
   if (!have_header) throw Error(where + ": empty file, expected a CSV header line");
+  // Tab-separated when the header has tabs and no comma (a TSV, or a spreadsheet's copy).
+  const char delimiter =
+      line.find('\t') != std::string::npos && line.find(',') == std::string::npos ? '\t' : ',';
   std::vector<std::string> header;
-  split(line, fields);
+  split(line, fields, delimiter);
   for (std::string_view f : fields) {
-    const std::string name(f);
+    std::string name(f);
+    if (const auto renamed = options.rename.find(name); renamed != options.rename.end()) {
+      name = renamed->second;
+    }
     if (!name.empty() && std::find(header.begin(), header.end(), name) != header.end()) {
       throw Error(where + ": column '" + name + "' appears twice in the header");
     }
@@ -202,11 +217,13 @@ CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::st
   for (const std::string& name : optional)
     want(name, false);
 
+  for (std::size_t skipped = 0; skipped < options.skip_rows && std::getline(in, line); ++skipped)
+    ++line_no;
   while (std::getline(in, line)) {
     ++line_no;
     const std::string_view t = trim(line);
     if (t.empty() || t.front() == '#') continue;
-    split(line, fields);
+    split(line, fields, delimiter);
     if (fields.size() != header.size()) {
       throw Error(where + " line " + std::to_string(line_no) + ": " +
                   std::to_string(fields.size()) + " fields, expected " +

@@ -155,6 +155,13 @@ TEST_F(BadInputTest, ImportBadOptions) {
   expect_clean_failure({"import", "good.csv", "--out", "nofolder/run.h5"},
                        {"nofolder/run.h5", "folder 'nofolder' does not exist"});
   expect_clean_failure({"import", "good.csv", "--out", "out"}, {"out: is a folder"});
+  expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--columns", "POSITION_X"},
+                       {"--columns 'POSITION_X': expected NAME=column,... e.g. POSITION_X=x"});
+  expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--columns", "A=x,A=y"},
+                       {"--columns 'A=x,A=y': A is named twice"});
+  // A mapping onto a name the table already has: the header holds it twice.
+  expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--columns", "y=x"},
+                       {"column 'x' appears twice in the header"});
 }
 
 TEST_F(BadInputTest, ImportSidecarCannotBeWritten) {

@@ -314,5 +314,57 @@ TEST_F(ImportTable, BadOptionsAreErrors) {
   EXPECT_EQ(import_table(file, good).header.length_unit, "mm");
 }
 
+// TrackMate's spot table: its own column names, quoted, three rows of names and units
+// under the header, text columns; mapped onto granmem's with CsvReadOptions.
+TEST_F(ImportTable, TrackMatesSpotTableWithItsColumnNames) {
+  const auto file = path("spots.csv");
+  write_text(file,
+             "\"LABEL\",\"ID\",\"TRACK_ID\",\"QUALITY\",\"POSITION_X\",\"POSITION_Y\","
+             "\"POSITION_Z\",\"FRAME\"\r\n"
+             "Label,Spot ID,Track ID,Quality,X,Y,Z,Frame\r\n"
+             "Label,Spot ID,Track ID,Quality,X,Y,Z,Frame\r\n"
+             ",,,(quality),(micron),(micron),(micron),\r\n"
+             "\"ID7, first\",7,0,31.2,10.5,20.25,3.0,0\r\n"
+             "ID8,8,1,30.0,40.0,20.0,3.5,0\r\n"
+             "ID9,9,0,29.1,10.75,20.5,3.25,1\r\n");
+  ImportOptions o;
+  o.length_unit = "um";
+  o.csv.rename = {{"FRAME", "frame"},
+                  {"TRACK_ID", "particle"},
+                  {"POSITION_X", "x"},
+                  {"POSITION_Y", "y"},
+                  {"POSITION_Z", "z"}};
+  o.csv.skip_rows = 3;
+  ImportSummary sum;
+  const Trajectories run = import_table(file, o, &sum);
+  EXPECT_EQ(sum.rows, 3u);
+  EXPECT_EQ(run.header.id, (std::vector<std::int64_t>{0, 1}));
+  ASSERT_EQ(run.frames.size(), 2u);
+  EXPECT_EQ(run.frames[1].position(0, 0), 10.75);
+  EXPECT_EQ(run.frames[0].position(1, 2), 3.5);
+  EXPECT_TRUE(std::isnan(run.frames[1].position(1, 0)));  // track 1 not in frame 1
+
+  // Without skipping the rows of names the first is not a number, and says where.
+  o.csv.skip_rows = 0;
+  try {
+    import_table(file, o);
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2, column 'frame': expected a number, found "
+                                         "'Frame'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(ImportTable, TabSeparatedTablesAreRead) {
+  const auto file = path("t.tsv");
+  write_text(file, "frame\tparticle\tx\ty\tz\n0\t5\t1.5\t2\t3\n1\t5\t1.75\t2\t3\n");
+  const Trajectories run = import_table(file, ImportOptions{});
+  ASSERT_EQ(run.frames.size(), 2u);
+  EXPECT_EQ(run.frames[1].position(0, 0), 1.75);
+  EXPECT_EQ(run.header.id, (std::vector<std::int64_t>{5}));
+}
+
 }  // namespace
 }  // namespace granmem

@@ -26,6 +26,8 @@ struct ImportOptions {
   // Container as (xmin, ymin, zmin, xmax, ymax, zmax) in the table's unit.
   std::optional<Box> box;
   std::string sample = kSampleEndOfCycle;
+  // Other programs' column names and header rows (TrackMate, MATLAB; files only).
+  CsvReadOptions csv;
 };
 
 struct ImportSummary {

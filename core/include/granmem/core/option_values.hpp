@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -34,6 +35,11 @@ struct VoxelSize {
   std::string unit;
 };
 VoxelSize parse_voxel_size(const std::string& text, const std::string& option);
+
+// "A=x,B=y" -> {A: x, B: y}: another program's names for granmem's columns. Error for an
+// item without '=' or a name given twice.
+std::map<std::string, std::string> parse_renames(const std::string& text,
+                                                 const std::string& option);
 
 // A time left, as a person reads it: "4m05s", "2h10m".
 std::string duration_text(double seconds);

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <deque>
 #include <filesystem>
+#include <map>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -56,11 +57,20 @@ struct CsvColumns {
   std::vector<std::size_t> lines;  // file line (1-based) of each row
 };
 
-// Reads a CSV with a header row; lines starting with '#' are comments, columns not asked
+// How to read another program's table: TrackMate's or a MATLAB script's column names mapped
+// onto granmem's, and the rows of text some programs put under the header.
+struct CsvReadOptions {
+  std::map<std::string, std::string> rename;  // the file's column name -> the name asked for
+  std::size_t skip_rows = 0;  // lines after the header that are not data (TrackMate: 3)
+};
+
+// Reads a CSV (RFC 4180: quoted fields, CRLF, a BOM) or, when the header has tabs and no
+// comma, a TSV, with a header row; lines starting with '#' are comments, columns not asked
 // for are skipped unread (a pandas index or text columns are fine). Empty fields and "nan"
 // read as NaN. Throws Error naming file, line and column for a missing required column or
 // a field that is not a number.
 CsvColumns read_csv(const std::filesystem::path& path, const std::vector<std::string>& required,
-                    const std::vector<std::string>& optional = {});
+                    const std::vector<std::string>& optional = {},
+                    const CsvReadOptions& options = {});
 
 }  // namespace granmem

@@ -24,7 +24,7 @@ from ._granmem import Error
 __version__ = _granmem.__version__
 
 __all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
-           "read_tracks", "write_run", "motion", "analyze"]
+           "read_tracks", "write_run", "motion", "analyze", "simulate"]
 
 
 def _frame(columns, units=None, **attrs):
@@ -215,3 +215,25 @@ def analyze(run, subtract_drift=False, wall_distance=0, box=None, hole_contacts=
     tables["pdfs"] = {q: _frame(*t, length_unit=unit) for q, t in out["pdfs"].items()}
     tables["notes"] = out["notes"]
     return tables
+
+
+def simulate(out=None, resume=None, start_from=None, threads=0, progress=None,
+             **settings):
+    """The embedded DEM, as ``granmem simulate``: grains deposited under a lid (or a packing
+    from ``start_from``'s checkpoint) and compressed cyclically; the end-of-cycle store at
+    ``out`` (read it with ``read_run`` or ``analyze``) and a checkpoint beside it.
+
+    ``settings``: simulate's options with ``_`` for ``-`` and their units as text, e.g.
+    ``grains=1500, box="5cm", lid_pressure="436Pa", amplitude="1%", mu_s=0.15, cycles=40``
+    (``granmem simulate --help`` lists them; the defaults are the paper's). ``resume``
+    continues a checkpoint's run (``cycles`` may be raised). ``progress(report)`` is called
+    with a dict: a ``line`` of what the run does, or ``cycle``, ``cycles``,
+    ``particle_steps_per_second``, ``seconds_left`` after each cycle. Ctrl-C (or an
+    exception in ``progress``) stops the run with a checkpoint and is raised; continue with
+    ``resume=``. Returns a dict: settings, grains, cycles_done, particle_steps_per_second,
+    written, checkpoint, report (the command line's summary)."""
+    if out is not None:
+        settings["out"] = os.fspath(out)
+    return _granmem.simulate(settings, os.fspath(resume) if resume else "",
+                             os.fspath(start_from) if start_from else "", int(threads),
+                             progress)

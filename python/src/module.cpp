@@ -9,9 +9,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "granmem/core/error.hpp"
@@ -24,6 +29,7 @@
 #include "granmem/core/version.hpp"
 #include "granmem/rotation/grain_motion.hpp"
 #include "granmem/rotation/motion_analysis.hpp"
+#include "granmem/sim/simulate.hpp"
 #include "granmem/tracking/detections.hpp"
 #include "granmem/tracking/link.hpp"
 #include "granmem/tracking/locate.hpp"
@@ -500,6 +506,158 @@ py::dict analyze_py(const std::filesystem::path& path, bool subtract_drift,
   return out;
 }
 
+// ------------------------------------------------------------------------------ simulate
+
+// What a job running on another thread reports: a line of what it does, or a cycle done.
+struct Report {
+  std::string line;  // empty for a cycle
+  CyclicProgress cycle;
+};
+
+// Reports queued by the job's thread, handed to Python on its own (main) thread.
+class ReportQueue {
+ public:
+  void push(Report r) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      reports_.push_back(std::move(r));
+    }
+    ready_.notify_one();
+  }
+  void finish() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      finished_ = true;
+    }
+    ready_.notify_one();
+  }
+  // Waits up to `timeout` for reports or the end; returns those queued, and whether the job
+  // has finished.
+  std::vector<Report> wait(std::chrono::milliseconds timeout, bool* finished) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ready_.wait_for(lock, timeout, [&] { return finished_ || !reports_.empty(); });
+    *finished = finished_;
+    return std::exchange(reports_, {});
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::vector<Report> reports_;
+  bool finished_ = false;
+};
+
+py::dict report_dict(const Report& r) {
+  py::dict d;
+  if (!r.line.empty()) {
+    d["line"] = r.line;
+    return d;
+  }
+  d["cycle"] = r.cycle.cycle;
+  d["cycles"] = r.cycle.cycles;
+  d["particle_steps_per_second"] = r.cycle.particle_steps_per_second;
+  d["seconds_left"] = r.cycle.seconds_left;
+  return d;
+}
+
+// Runs `job` on its own thread while Python's thread waits in 0.1 s slices without the GIL:
+// between them it hands the reports to `progress` (a callable taking a dict, or None) and
+// looks for Ctrl-C, which sets `stop` (the job then stops at its next check, a checkpoint
+// written) and is raised as KeyboardInterrupt once the job has returned.
+template <class Job>
+auto run_interruptible(Job job, ReportQueue& queue, std::atomic<bool>& stop,
+                       const py::object& progress) {
+  decltype(job()) result{};
+  std::exception_ptr failure;
+  std::thread worker([&] {
+    try {
+      result = job();
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    queue.finish();
+  });
+  std::optional<py::error_already_set> interrupt;
+  for (bool finished = false; !finished;) {
+    std::vector<Report> reports;
+    {
+      py::gil_scoped_release release;
+      reports = queue.wait(std::chrono::milliseconds(100), &finished);
+    }
+    for (const Report& r : reports) {
+      if (progress.is_none() || interrupt) continue;
+      try {
+        progress(report_dict(r));
+      } catch (py::error_already_set& e) {  // the callback raised: stop, and raise it after
+        interrupt.emplace(std::move(e));
+        stop = true;
+      }
+    }
+    if (!interrupt && PyErr_CheckSignals() != 0) {
+      interrupt.emplace();  // takes Python's pending KeyboardInterrupt
+      stop = true;
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  if (failure) std::rethrow_exception(failure);
+  if (interrupt) throw std::move(*interrupt);
+  return result;
+}
+
+std::string setting_text(const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::isinstance<py::int_>(value) || py::isinstance<py::float_>(value)) {
+    return py::str(py::repr(value));
+  }
+  if (py::isinstance<py::sequence>(value)) {  // a list of grain ids or cycles
+    std::string text;
+    for (const py::handle& item : value.cast<py::sequence>())
+      text += (text.empty() ? "" : ",") + setting_text(item);
+    return text;
+  }
+  throw Error("a setting must be text, a number, a bool or a list, got " +
+              std::string(py::str(value.get_type())));
+}
+
+py::dict simulate_py(const py::dict& settings, const std::string& resume,
+                     const std::string& start_from, int threads, const py::object& progress) {
+  SimulateOptions o;
+  for (const auto& [key, value] : settings) {
+    std::string name = py::str(key);
+    std::replace(name.begin(), name.end(), '_', '-');
+    if (!o.settings.count(name)) {
+      throw Error("simulate: no setting '" + name + "' (see granmem simulate --help)");
+    }
+    o.settings[name] = setting_text(value);
+    o.given.insert(name);
+  }
+  o.resume = resume;
+  o.start_from = start_from;
+  o.threads = threads;
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  o.log = [&](const std::string& line) { queue.push({line, {}}); };
+  o.progress = [&](const CyclicProgress& p) { queue.push({"", p}); };
+  o.stop = &stop;
+  const SimulateSummary s = run_interruptible([&] { return simulate(o); }, queue, stop, progress);
+  py::dict out;
+  out["settings"] = s.settings;
+  out["grains"] = s.grains;
+  out["cycles_done"] = s.cycles.cycles_done;
+  out["particle_steps_per_second"] = s.cycles.particle_steps_per_second;
+  std::vector<std::string> written;
+  for (const auto& p : s.cycles.written)
+    written.push_back(p.string());
+  out["written"] = written;
+  out["checkpoint"] = s.checkpoint;
+  out["report"] = s.Report();
+  return out;
+}
+
 }  // namespace
 }  // namespace granmem::python
 
@@ -546,6 +704,8 @@ PYBIND11_MODULE(_granmem, m) {
       py::arg("path"));
   m.def("write_run", &write_run_py, py::arg("columns"), py::arg("path"), py::arg("length_unit"),
         py::arg("radius") = py::none());
+  m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
+        py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
   m.def("analyze", &analyze_py, py::arg("path"), py::arg("subtract_drift") = false,
         py::arg("wall_distance") = "0", py::arg("box") = py::none(),
         py::arg("hole_contacts") = "keep", py::arg("pdf") = std::vector<std::string>{},

@@ -1,4 +1,4 @@
-#include "simulation_settings.hpp"
+#include "granmem/sim/simulate_settings.hpp"
 
 #include <cmath>
 #include <iterator>
@@ -8,7 +8,7 @@
 #include "granmem/core/units.hpp"
 #include "granmem/sim/quasi_static.hpp"
 
-namespace granmem::app {
+namespace granmem {
 
 namespace {
 constexpr const char* kPaperLidPressureText = "436Pa";  // kPaperLidPressure, as given
@@ -85,76 +85,83 @@ const char* const kPackingOptions[] = {"grains",
                                        "settling-damping"};
 const std::size_t kPackingOptionCount = std::size(kPackingOptions);
 
-double number(const std::map<std::string, std::string>& v, const std::string& name) {
+RunSettings default_simulate_settings() {
+  RunSettings v;
+  for (const OptionSpec& o : kSimulateOptions)
+    v[o.name] = o.default_value;
+  return v;
+}
+
+double setting_number(const RunSettings& v, const std::string& name) {
   const Quantity q = parse_quantity(v.at(name), "--" + name);
   if (!q.unit.empty()) throw Error("--" + name + " '" + v.at(name) + "': expected a plain number");
   return q.value;
 }
-double si(const std::map<std::string, std::string>& v, const std::string& name, Dimension d,
-          const char* default_unit) {
+double setting_si(const RunSettings& v, const std::string& name, Dimension d,
+                  const char* default_unit) {
   return parse_si(v.at(name), d, default_unit, "--" + name);
 }
-std::int64_t whole(const std::map<std::string, std::string>& v, const std::string& name) {
-  const double x = number(v, name);
+std::int64_t setting_whole(const RunSettings& v, const std::string& name) {
+  const double x = setting_number(v, name);
   if (x != std::floor(x) || x < 0 || x > 9e15) {
     throw Error("--" + name + " '" + v.at(name) + "': expected a whole number >= 0");
   }
   return std::int64_t(x);
 }
-bool yes_no(const std::map<std::string, std::string>& v, const std::string& name) {
+bool setting_yes_no(const RunSettings& v, const std::string& name) {
   const std::string& x = v.at(name);
   if (x == "true" || x == "yes" || x == "on" || x == "1") return true;
   if (x == "false" || x == "no" || x == "off" || x == "0") return false;
   throw Error("--" + name + " '" + x + "': expected true or false");
 }
 
-PhysicsOptions physics_from(const std::map<std::string, std::string>& v) {
+PhysicsOptions physics_from(const RunSettings& v) {
   PhysicsOptions p;
-  p.contact.k_n = si(v, "k-n", Dimension::stiffness);
-  p.contact.restitution_n = number(v, "restitution-n");
-  p.contact.restitution_t = number(v, "restitution-t");
-  p.contact.k_t_over_k_n = number(v, "kt-over-kn");
-  p.contact.mu_s = number(v, "mu-s");
-  p.contact.mu_r = number(v, "mu-r");
-  p.contact.mu_t = number(v, "mu-t");
-  p.contact.beta = number(v, "beta");
+  p.contact.k_n = setting_si(v, "k-n", Dimension::stiffness);
+  p.contact.restitution_n = setting_number(v, "restitution-n");
+  p.contact.restitution_t = setting_number(v, "restitution-t");
+  p.contact.k_t_over_k_n = setting_number(v, "kt-over-kn");
+  p.contact.mu_s = setting_number(v, "mu-s");
+  p.contact.mu_r = setting_number(v, "mu-r");
+  p.contact.mu_t = setting_number(v, "mu-t");
+  p.contact.beta = setting_number(v, "beta");
   auto wall = [&](const char* name, double grain) {
-    return v.at(name) == "same" ? grain : number(v, name);
+    return v.at(name) == "same" ? grain : setting_number(v, name);
   };
   p.wall = {wall("wall-mu-s", p.contact.mu_s), wall("wall-mu-r", p.contact.mu_r),
             wall("wall-mu-t", p.contact.mu_t)};
-  p.density = si(v, "density", Dimension::density);
-  p.gravity = si(v, "gravity", Dimension::acceleration);
-  p.dt = si(v, "dt", Dimension::time);
-  p.skin = si(v, "skin", Dimension::length);
+  p.density = setting_si(v, "density", Dimension::density);
+  p.gravity = setting_si(v, "gravity", Dimension::acceleration);
+  p.dt = setting_si(v, "dt", Dimension::time);
+  p.skin = setting_si(v, "skin", Dimension::length);
   return p;
 }
 
-double lid_mass_from(const std::map<std::string, std::string>& v, double box, double gravity) {
+double lid_mass_from(const RunSettings& v, double box, double gravity) {
   if (v.at("lid-mass") != "auto") {
     if (v.at("lid-pressure") != kPaperLidPressureText) {
       throw Error("--lid-mass " + v.at("lid-mass") + " and --lid-pressure " + v.at("lid-pressure") +
                   ": give the lid's mass or its pressure, not both");
     }
-    return si(v, "lid-mass", Dimension::mass);
+    return setting_si(v, "lid-mass", Dimension::mass);
   }
-  const double pressure = si(v, "lid-pressure", Dimension::pressure);
+  const double pressure = setting_si(v, "lid-pressure", Dimension::pressure);
   if (!(pressure >= 0)) {
     throw Error("--lid-pressure '" + v.at("lid-pressure") + "': must be zero or positive");
   }
   return lid_mass_for_pressure(pressure, gravity, box, box);
 }
 
-DepositOptions deposit_from(const std::map<std::string, std::string>& v) {
+DepositOptions deposit_from(const RunSettings& v) {
   DepositOptions d;
-  d.grains = whole(v, "grains");
-  d.radius = 0.5 * si(v, "diameter", Dimension::length);
-  d.polydispersity = number(v, "polydispersity");
-  d.box_side = si(v, "box", Dimension::length);
-  d.lid_mass = lid_mass_from(v, d.box_side, si(v, "gravity", Dimension::acceleration));
-  d.seed = std::uint64_t(whole(v, "seed"));
-  d.settled_energy = si(v, "settled-energy", Dimension::energy);
-  d.settling_damping = number(v, "settling-damping");
+  d.grains = setting_whole(v, "grains");
+  d.radius = 0.5 * setting_si(v, "diameter", Dimension::length);
+  d.polydispersity = setting_number(v, "polydispersity");
+  d.box_side = setting_si(v, "box", Dimension::length);
+  d.lid_mass = lid_mass_from(v, d.box_side, setting_si(v, "gravity", Dimension::acceleration));
+  d.seed = std::uint64_t(setting_whole(v, "seed"));
+  d.settled_energy = setting_si(v, "settled-energy", Dimension::energy);
+  d.settling_damping = setting_number(v, "settling-damping");
   if (!(d.box_side > 0)) throw Error("--box '" + v.at("box") + "': must be positive");
   if (!(d.radius > 0)) throw Error("--diameter '" + v.at("diameter") + "': must be positive");
   if (!(d.polydispersity >= 0 && d.polydispersity < 1)) {
@@ -163,8 +170,8 @@ DepositOptions deposit_from(const std::map<std::string, std::string>& v) {
   return d;
 }
 
-WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsOptions& physics,
-                     double box, double box_y, double lid_mass, double radius) {
+WallDrive drive_from(const RunSettings& v, const PhysicsOptions& physics, double box, double box_y,
+                     double lid_mass, double radius) {
   WallDrive d;
   d.amplitude = parse_amplitude(v.at("amplitude"), box_y, "--amplitude");
   d.symmetry = parse_drive_symmetry(v.at("drive"));
@@ -174,21 +181,21 @@ WallDrive drive_from(const std::map<std::string, std::string>& v, const PhysicsO
       throw Error("--amplitude " + v.at("amplitude") +
                   ": a still wall has no quasi-static period; give --period");
     }
-    if (!(number(v, "inertial-number") > 0)) {
+    if (!(setting_number(v, "inertial-number") > 0)) {
       throw Error("--inertial-number " + v.at("inertial-number") + ": must be positive");
     }
     const double stress = confining_stress(lid_pressure(lid_mass, physics.gravity, box, box),
                                            physics.density, physics.gravity, 2 * radius);
-    d.period = quasi_static_period(number(v, "inertial-number"), d, box_y, 2 * radius, stress,
-                                   physics.density);
+    d.period = quasi_static_period(setting_number(v, "inertial-number"), d, box_y, 2 * radius,
+                                   stress, physics.density);
   } else {
-    d.period = si(v, "period", Dimension::time);
+    d.period = setting_si(v, "period", Dimension::time);
   }
   return d;
 }
 
-std::vector<std::int64_t> whole_list(const std::map<std::string, std::string>& v,
-                                     const std::string& name, const char* example) {
+std::vector<std::int64_t> whole_list(const RunSettings& v, const std::string& name,
+                                     const char* example) {
   std::vector<std::int64_t> out;
   std::stringstream list(v.at(name));
   for (std::string item; std::getline(list, item, ',');) {
@@ -202,8 +209,8 @@ std::vector<std::int64_t> whole_list(const std::map<std::string, std::string>& v
   return out;
 }
 
-bool wall_friction_follows(const std::map<std::string, std::string>& v) {
+bool wall_friction_follows(const RunSettings& v) {
   return v.at("wall-mu-s") == "same";
 }
 
-}  // namespace granmem::app
+}  // namespace granmem

@@ -24,7 +24,7 @@ from ._granmem import Error
 __version__ = _granmem.__version__
 
 __all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
-           "read_tracks", "write_run", "motion", "analyze", "simulate"]
+           "read_tracks", "write_run", "motion", "analyze", "simulate", "readout"]
 
 
 def _frame(columns, units=None, **attrs):
@@ -237,3 +237,30 @@ def simulate(out=None, resume=None, start_from=None, threads=0, progress=None,
     return _granmem.simulate(settings, os.fspath(resume) if resume else "",
                              os.fspath(start_from) if start_from else "", int(threads),
                              progress)
+
+
+def readout(states, out, amplitudes="0.05%:2.5%:12", cycles=1, drive="asymmetric",
+            wall_motion="cosine", inertial_number=1e-3, training_amplitude=True, parallel=0,
+            bootstrap=200, progress=None):
+    """The paper's memory read-out, as ``granmem readout``: one run of ``cycles`` cycles at
+    each amplitude A' from each trained state (checkpoints, e.g. ``simulate(...,
+    keep_states=[10, 100])``), ``parallel`` at once, stores in the folder ``out`` (finished
+    runs are reused when called again).
+
+    ``amplitudes``: "lo%:hi%:count" (log-spaced) or a list of percentages, e.g. [0.5, 1, 2].
+    Returns a dict: ``points`` (a DataFrame of the read-out curves: state, amplitude_pct,
+    cycle, dr_d, msd_d2, rotations, their errors) and ``signatures`` (each state's memory:
+    the dip at its training amplitude, the ratio to an untrained packing, the rotations'
+    power laws). Ctrl-C stops after the runs under way and is raised."""
+    if not isinstance(amplitudes, str):
+        amplitudes = ",".join(f"{a}%" for a in amplitudes)
+    if isinstance(states, (str, os.PathLike)):
+        states = [states]
+    out_dict = _granmem.readout([os.fspath(s) for s in states], os.fspath(out), amplitudes,
+                                int(cycles), drive, wall_motion, float(inertial_number),
+                                bool(training_amplitude), int(parallel), int(bootstrap),
+                                progress)
+    return {"points": _frame(*out_dict["points"], length_unit="d"),
+            "signatures": _frame(*out_dict["signatures"]),
+            "diameter": out_dict["diameter"], "table": out_dict["table"],
+            "signature_table": out_dict["signature_table"]}

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "granmem/calibration/readout.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/import_table.hpp"
 #include "granmem/core/option_values.hpp"
@@ -658,6 +659,45 @@ py::dict simulate_py(const py::dict& settings, const std::string& resume,
   return out;
 }
 
+// ------------------------------------------------------------------------------ readout
+
+py::dict readout_py(const std::vector<std::filesystem::path>& states,
+                    const std::filesystem::path& out, const std::string& amplitudes,
+                    std::int64_t cycles, const std::string& drive, const std::string& wall_motion,
+                    double inertial_number, bool training_amplitude, int parallel,
+                    std::size_t bootstrap, const py::object& progress) {
+  ReadoutOptions o;
+  o.sweep.states = states;
+  o.sweep.amplitudes = parse_amplitude_sweep(amplitudes);
+  o.sweep.cycles = cycles;
+  o.sweep.symmetry = parse_drive_symmetry(drive);
+  o.sweep.shape = parse_drive_shape(wall_motion);
+  o.sweep.inertial_number = inertial_number;
+  o.sweep.include_training_amplitude = training_amplitude;
+  o.sweep.pool.parallel = parallel;
+  o.sweep.dir = out;
+  o.bootstrap = bootstrap;
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  o.sweep.pool.stop = &stop;
+  const ReadoutSummary s = run_interruptible(
+      [&] {
+        return readout(o, [&](const ReadoutSweepProgress& p) {
+          queue.push(
+              {"readout: " + std::to_string(p.done) + "/" + std::to_string(p.runs) + " runs done",
+               {}});
+        });
+      },
+      queue, stop, progress);
+  py::dict d;
+  d["points"] = table_result(readout_table(s.points));
+  d["signatures"] = table_result(signature_table(s.signatures));
+  d["diameter"] = s.diameter;
+  d["table"] = s.table.string();
+  d["signature_table"] = s.signature_table.string();
+  return d;
+}
+
 }  // namespace
 }  // namespace granmem::python
 
@@ -706,6 +746,12 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("radius") = py::none());
   m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
+  m.def("readout", &readout_py, py::arg("states"), py::arg("out"),
+        py::arg("amplitudes") = "0.05%:2.5%:12", py::arg("cycles") = 1,
+        py::arg("drive") = "asymmetric", py::arg("wall_motion") = "cosine",
+        py::arg("inertial_number") = ReadoutSweepOptions{}.inertial_number,
+        py::arg("training_amplitude") = true, py::arg("parallel") = 0,
+        py::arg("bootstrap") = ReadoutOptions{}.bootstrap, py::arg("progress") = py::none());
   m.def("analyze", &analyze_py, py::arg("path"), py::arg("subtract_drift") = false,
         py::arg("wall_distance") = "0", py::arg("box") = py::none(),
         py::arg("hole_contacts") = "keep", py::arg("pdf") = std::vector<std::string>{},

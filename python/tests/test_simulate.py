@@ -1,5 +1,6 @@
 """granmem.simulate: the command line's run from Python, interrupted and resumed."""
 import numpy as np
+import pandas as pd
 import pytest
 
 import granmem
@@ -74,3 +75,22 @@ def test_ctrl_c_stops_with_a_checkpoint(tmp_path):
     resumed = granmem.simulate(resume=tmp_path / "run.checkpoint.h5", cycles=frames + 1,
                                threads=1)
     assert resumed["cycles_done"] == frames + 1
+
+
+def test_readout_in_python_equals_the_command_line(tmp_path, cli):
+    granmem.simulate(out=tmp_path / "train.h5", cycles=2, keep_states=[2], **TINY)
+    state = tmp_path / "train_state_cycle2.h5"
+    reports = []
+    ours = granmem.readout(state, tmp_path / "py", amplitudes=[0.5, 2], parallel=1,
+                           bootstrap=20, progress=reports.append)
+    points = ours["points"]
+    # Two amplitudes and the training amplitude (1 %), one read-out cycle each.
+    assert list(points.amplitude_pct) == pytest.approx([0.5, 1, 2])
+    assert (points.dr_d > 0).all()
+    assert reports[-1]["line"] == "readout: 3/3 runs done"
+    cli("readout", "--from", state, "--amplitudes", "0.5%,2%", "--parallel", "1",
+        "--bootstrap", "20", "--out", "cli")
+    theirs = pd.read_csv(tmp_path / "cli" / "readout.csv", comment="#")
+    assert list(theirs.columns) == list(points.columns)
+    for c in points.columns:
+        np.testing.assert_allclose(points[c], theirs[c], rtol=1e-12, equal_nan=True, err_msg=c)

@@ -26,8 +26,9 @@ RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
   std::atomic<std::size_t> next{0}, done{0};
   std::mutex failed;
   std::exception_ptr failure;
+  auto stopped = [&] { return options.stop && options.stop->load(); };
   auto work = [&] {
-    for (std::size_t t; (t = next++) < mine.size();) {
+    for (std::size_t t; !stopped() && (t = next++) < mine.size();) {
       try {
         run(mine[t]);
         ++done;
@@ -47,6 +48,10 @@ RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
   const bool any_failed = mpi_any(failure != nullptr);  // every rank waits for every run
   if (failure) std::rethrow_exception(failure);
   if (any_failed) throw Error("run pool: a run failed on another rank (its error is in its log)");
+  if (done < mine.size() && stopped()) {
+    throw Error("stopped after " + std::to_string(done.load()) + " of " +
+                std::to_string(mine.size()) + " runs (finished runs are reused when run again)");
+  }
   return {done.load(), workers, ranks.size};
 }
 

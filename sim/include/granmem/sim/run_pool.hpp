@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 
@@ -11,6 +12,9 @@ namespace granmem {
 struct RunPoolOptions {
   int parallel = 0;  // runs at once in this process; 0: one per core (shared by the ranks
                      // of an MPI job on the same machine)
+  // Set (Python's KeyboardInterrupt): no further run is started, those under way finish,
+  // and run_pool throws an Error saying how many were done.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct RunPoolSummary {

@@ -26,10 +26,7 @@ def test_locate_finds_every_grain_to_a_tenth_of_a_voxel():
     stack, voxel, truth = render(lattice())
     assert stack.dtype == np.uint8 and stack.ndim == 3
     assert voxel == pytest.approx((VOXEL_MM, VOXEL_MM, VOXEL_MM))
-    # Without the illumination correction: on a lattice's flat layers its per-slice scales
-    # pull the layers' z by 0.3 voxel (a finding of this test, reported on the issue).
-    found = granmem.locate(stack, diameter="5mm", voxel_size=voxel, unit="mm",
-                           illumination=False)
+    found = granmem.locate(stack, diameter="5mm", voxel_size=voxel, unit="mm")
     assert found.attrs["length_unit"] == "mm"
     assert list(found.columns[:8]) == ["frame", "particle", "x", "y", "z", "radius", "quality",
                                        "edge"]

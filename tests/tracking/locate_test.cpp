@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include "checks.hpp"
 #include "granmem/core/error.hpp"
@@ -310,6 +311,61 @@ TEST(Locate, BrightGrainsWithoutHoles) {
   const LocateScore s = score_locate(d, truth, *scan.options.voxel_size);
   report("d = 12, bright grains, no holes", s);
   expect_accurate(s);
+}
+
+// Grains in flat layers, as a packing is against a floor or a wall: the illumination
+// correction's levels must not follow the layers (slices between two layers, or through
+// their caps, are nearly all fluid, or all partial volumes). Measured before the levels
+// were pooled over slices: layers pulled by up to 0.5 voxel along z.
+TEST(Locate, LayeredGrainsKeepEachLayersHeight) {
+  for (const int layers : {2, 4}) {
+    std::mt19937_64 rng{std::uint64_t(layers)};
+    std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+    std::normal_distribution<double> normal;
+    std::vector<RenderedGrain> grains;
+    for (int k = 0; k < layers; ++k) {
+      for (int j = 0; j < 3; ++j) {
+        for (int i = 0; i < 3; ++i) {  // 5 mm grains on a 5.6 mm lattice, jittered
+          RenderedGrain g;
+          g.id = std::int64_t(grains.size());
+          g.centre = Eigen::Vector3d(i, j, k) * 5.6 + Eigen::Vector3d::Constant(4.0) +
+                     Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+          g.radius = 2.5;
+          g.axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+          grains.push_back(g);
+        }
+      }
+    }
+    RenderOptions r;
+    r.length_unit = "mm";
+    r.diameter_px = 10;
+    r.seed = 3;
+    Table truth;
+    Stack stack = render_scan(grains, r, &truth);
+    const Eigen::Vector3d vs = *stack.voxel_size;
+    LocateOptions o;
+    o.diameter = 10;
+    const Detections d = locate(stack, o);
+    ASSERT_EQ(d.size(), grains.size());
+    for (int k = 0; k < layers; ++k) {  // each layer's mean error along z
+      double sum = 0;
+      for (std::size_t g = std::size_t(9 * k); g < std::size_t(9 * (k + 1)); ++g) {
+        const Eigen::Vector3d t(truth["x"].values[g], truth["y"].values[g], truth["z"].values[g]);
+        double best = 1e9, dz = 0;
+        for (std::size_t i = 0; i < d.size(); ++i) {
+          const Eigen::Vector3d found =
+              d.position.row(Eigen::Index(i)).transpose().cwiseQuotient(vs);
+          if ((found - t).norm() < best) {
+            best = (found - t).norm();
+            dz = found.z() - t.z();
+          }
+        }
+        EXPECT_LT(best, 0.2) << layers << " layers, grain " << g;
+        sum += dz;
+      }
+      EXPECT_LT(std::abs(sum / 9), 0.08) << layers << " layers, layer " << k;
+    }
+  }
 }
 
 TEST(Locate, DiameterLargerThanTheStackIsAnError) {

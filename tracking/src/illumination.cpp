@@ -7,6 +7,26 @@
 #include "granmem/core/error.hpp"
 
 namespace granmem {
+namespace {
+
+// Voxels a slice needs of a phase for its level to be measured there.
+constexpr std::size_t kMinVoxels = 32;
+
+// Each slice's value replaced by the median over the slices within `reach` of it.
+std::vector<double> pooled_median(const std::vector<double>& per_slice, std::int64_t reach) {
+  const auto n = std::int64_t(per_slice.size());
+  std::vector<double> out(per_slice.size()), window;
+  for (std::int64_t z = 0; z < n; ++z) {
+    window.assign(per_slice.begin() + std::max<std::int64_t>(0, z - reach),
+                  per_slice.begin() + std::min(n, z + reach + 1));
+    std::nth_element(window.begin(), window.begin() + std::ptrdiff_t(window.size() / 2),
+                     window.end());
+    out[std::size_t(z)] = window[window.size() / 2];
+  }
+  return out;
+}
+
+}  // namespace
 
 void normalize_illumination(Stack& stack, const IlluminationOptions& o) {
   if (!(o.diameter > 0)) throw Error("illumination: the grain diameter must be positive");
@@ -18,28 +38,48 @@ void normalize_illumination(Stack& stack, const IlluminationOptions& o) {
     return o.beam_axis == 0 ? slice[l * stack.nx + s] : slice[s * stack.nx + l];
   };
 
-  // Pass 1, per slice: the split between fluid and grain (halfway between the slice's low
-  // and high levels; illumination changes levels far less than the contrast), the fluid's
-  // sum and count at each position along the beam, and the median grain voxel.
-  std::vector<double> middle(nz), grain_median(nz), fallback(nz);
-  std::vector<std::vector<double>> fluid_sum(nz, std::vector<double>(len)),
-      fluid_count(nz, std::vector<double>(len));
+  // Pass 1, per slice: the slice's low and high levels (grain and fluid percentiles), then
+  // the split between fluid and grain halfway between them, each pooled over the slices
+  // within two diameters: a slice between two layers of grains, or above the packing, is
+  // nearly all fluid, and its own percentiles would put the split inside the fluid.
+  const auto reach = std::int64_t(std::ceil(2 * o.diameter));
+  std::vector<double> low(nz), high(nz);
 #pragma omp parallel
   {
-    std::vector<double> sample, grains;
+    std::vector<double> sample;
 #pragma omp for schedule(dynamic, 2)
     for (std::int64_t z = 0; z < stack.nz; ++z) {
-      std::uint16_t* slice = stack.slice(z);
+      const std::uint16_t* slice = stack.slice(z);
       sample.assign(slice, slice + stack.nx * stack.ny);
       const auto q = [&](double p) {
         const auto i = std::size_t(p * double(sample.size() - 1));
         std::nth_element(sample.begin(), sample.begin() + std::ptrdiff_t(i), sample.end());
         return sample[i];
       };
-      const double high = q(o.fluid_percentile), low = q(o.grain_percentile);
+      high[std::size_t(z)] = q(o.fluid_percentile);
+      low[std::size_t(z)] = q(o.grain_percentile);
+    }
+  }
+  const std::vector<double> pooled_low = pooled_median(low, reach),
+                            pooled_high = pooled_median(high, reach);
+
+  // Then the fluid's sum and count at each position along the beam, and the median grain
+  // voxel.
+  std::vector<double> middle(nz), grain_median(nz), fallback(nz);
+  std::vector<std::vector<double>> fluid_sum(nz, std::vector<double>(len)),
+      fluid_count(nz, std::vector<double>(len));
+#pragma omp parallel
+  {
+    std::vector<double> grains;
+#pragma omp for schedule(dynamic, 2)
+    for (std::int64_t z = 0; z < stack.nz; ++z) {
+      std::uint16_t* slice = stack.slice(z);
       const auto zi = std::size_t(z);
-      middle[zi] = 0.5 * (high + low);
-      fallback[zi] = o.dark_grains ? low : high;
+      middle[zi] = 0.5 * (pooled_high[zi] + pooled_low[zi]);
+      fallback[zi] = o.dark_grains ? pooled_low[zi] : pooled_high[zi];
+      // The dark level from voxels well inside grains: a slice through the caps of a layer
+      // holds mostly the partial volumes of grain surfaces, above the grains' level.
+      const double deep_grain = middle[zi] - 0.5 * (middle[zi] - fallback[zi]);
       grains.clear();
       for (std::int64_t l = 0; l < lines; ++l) {
         for (std::int64_t s = 0; s < length; ++s) {
@@ -47,13 +87,13 @@ void normalize_illumination(Stack& stack, const IlluminationOptions& o) {
           if (sign * (v - middle[zi]) > 0) {
             fluid_sum[zi][std::size_t(s)] += v;
             fluid_count[zi][std::size_t(s)] += 1;
-          } else {
+          } else if (sign * (v - deep_grain) < 0) {
             grains.push_back(v);
           }
         }
       }
-      grain_median[zi] = fallback[zi];
-      if (!grains.empty()) {
+      grain_median[zi] = std::nan("");
+      if (grains.size() >= kMinVoxels) {
         std::nth_element(grains.begin(), grains.begin() + std::ptrdiff_t(grains.size() / 2),
                          grains.end());
         grain_median[zi] = grains[grains.size() / 2];
@@ -66,7 +106,6 @@ void normalize_illumination(Stack& stack, const IlluminationOptions& o) {
   // diameter along the beam), which takes the packing's structure out of them. Flicker
   // and streaks, which do change from one slice or line to the next, go into the line
   // scales below.
-  const auto reach = std::int64_t(std::ceil(2 * o.diameter));
   const auto half = std::int64_t(std::ceil(0.5 * o.diameter));
   std::vector<std::vector<double>> shape(nz, std::vector<double>(len, 1.0));
   std::vector<double> grain_level(nz);
@@ -79,11 +118,16 @@ void normalize_illumination(Stack& stack, const IlluminationOptions& o) {
       const std::int64_t z0 = std::max<std::int64_t>(0, z - reach);
       const std::int64_t z1 = std::min(stack.nz - 1, z + reach);
       levels.clear();
-      for (std::int64_t w = z0; w <= z1; ++w)
-        levels.push_back(grain_median[std::size_t(w)]);
-      std::nth_element(levels.begin(), levels.begin() + std::ptrdiff_t(levels.size() / 2),
-                       levels.end());
-      grain_level[zi] = levels[levels.size() / 2];
+      for (std::int64_t w = z0; w <= z1; ++w) {
+        if (!std::isnan(grain_median[std::size_t(w)]))
+          levels.push_back(grain_median[std::size_t(w)]);
+      }
+      grain_level[zi] = fallback[zi];
+      if (!levels.empty()) {
+        std::nth_element(levels.begin(), levels.begin() + std::ptrdiff_t(levels.size() / 2),
+                         levels.end());
+        grain_level[zi] = levels[levels.size() / 2];
+      }
       double mean = 0;
       for (std::int64_t s = 0; s < length; ++s) {
         double sum = 0, count = 0;

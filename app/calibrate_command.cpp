@@ -10,7 +10,7 @@
 #include <thread>
 
 #include "commands.hpp"
-#include "comparison_report.hpp"
+#include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/figures.hpp"
 #include "granmem/calibration/friction_fit.hpp"
 #include "granmem/calibration/friction_series.hpp"
@@ -72,6 +72,14 @@ void check_against_experiment(const RunHeader& experiment, const std::string& fi
       }
     }
   }
+}
+
+// The comparison's lines printed, its notes on stderr.
+Comparison reported(Comparison c) {
+  for (const std::string& note : c.notes)
+    std::cerr << "granmem: note: " << note << "\n";
+  std::cout << c.Report();
+  return c;
 }
 
 std::string json_number(double x) {
@@ -237,8 +245,9 @@ Comparison compare_at_fit(const SteadyStateJob& job, const FrictionRunSpec& best
   if (!mpi_ranks().root()) return {};
   std::string label = "DEM mu_s = " + json_number(best.mu_s);
   if (best.mu_r >= 0) label += ", mu_r = " + json_number(best.mu_r);
-  return compare_runs(job.experiment, TrajectoryReader(friction_run_path(job.runs_dir, best)),
-                      "experiment", label, job.observe, Eigen::Vector3d::Zero(), 0, job.out);
+  return reported(
+      compare_runs(job.experiment, TrajectoryReader(friction_run_path(job.runs_dir, best)),
+                   "experiment", label, job.observe, Eigen::Vector3d::Zero(), 0, job.out));
 }
 
 // summary.json of a steady-state fit: `fitted` holds the fit's own members.
@@ -741,8 +750,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     std::vector<fs::path> figures = calibration_figures(out, fit, run_mu);
     // The distances at the fit: the run at the fitted mu_s with the fitted locating noise.
     const Comparison compared =
-        compare_runs(experiment, best_run, "experiment", "DEM mu_s = " + json_number(best), observe,
-                     fit_options.noise_shape, fit.noise_sigma, out);
+        reported(compare_runs(experiment, best_run, "experiment", "DEM mu_s = " + json_number(best),
+                              observe, fit_options.noise_shape, fit.noise_sigma, out));
     figures.insert(figures.end(), compared.written.begin(), compared.written.end());
     auto distance = [&](const std::string& q, bool wasserstein) {
       const auto it = compared.distances.find(q);

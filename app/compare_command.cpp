@@ -1,7 +1,7 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "comparison_report.hpp"
+#include "granmem/calibration/comparison.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
@@ -47,25 +47,21 @@ void add_compare(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([args] {
     const TrajectoryReader a(args->a), b(args->b);
-    ObservableOptions o;
-    o.motion.subtract_drift = !args->keep_drift;
-    o.motion.wall_distance =
-        parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
-    o.diameter = args->diameter.empty()
-                     ? median_diameter(a)
-                     : parse_si(args->diameter, Dimension::length, "", "--diameter");
-    if (args->window.empty()) {
-      const std::int64_t last = std::min(a.steps().back(), b.steps().back());
-      const std::int64_t first = std::max(a.steps().front(), b.steps().front()) + 1;
-      o.window = {std::max(first, last - 9), last};
-    } else {
-      o.window = parse_int_range(args->window, "--window");
+    CompareOptions o;
+    o.label_a = args->label_a;
+    o.label_b = args->label_b;
+    if (!args->window.empty()) o.window = parse_int_range(args->window, "--window");
+    if (!args->diameter.empty()) {
+      o.diameter = parse_si(args->diameter, Dimension::length, "", "--diameter");
     }
-    PowerLawOptions relaxation;
-    relaxation.steady_points = args->steady_points;
-    const Comparison c = compare_runs(a, b, args->label_a, args->label_b, o,
-                                      Eigen::Vector3d::Ones(), 0.0, args->out, relaxation);
-    std::cout << "wrote " << c.written.size() << " files in " << args->out << "\n";
+    o.wall_distance = parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
+    o.subtract_drift = !args->keep_drift;
+    o.steady_points = args->steady_points;
+    o.dir = args->out;
+    const Comparison c = compare(a, b, o);
+    for (const std::string& note : c.notes)
+      std::cerr << "granmem: note: " << note << "\n";
+    std::cout << c.Report() << "wrote " << c.written.size() << " files in " << args->out << "\n";
   });
 }
 

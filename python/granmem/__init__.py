@@ -24,7 +24,7 @@ from ._granmem import Error
 __version__ = _granmem.__version__
 
 __all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
-           "read_tracks", "write_run", "motion", "analyze", "simulate", "readout"]
+           "read_tracks", "write_run", "motion", "analyze", "simulate", "readout", "compare"]
 
 
 def _frame(columns, units=None, **attrs):
@@ -264,3 +264,19 @@ def readout(states, out, amplitudes="0.05%:2.5%:12", cycles=1, drive="asymmetric
             "signatures": _frame(*out_dict["signatures"]),
             "diameter": out_dict["diameter"], "table": out_dict["table"],
             "signature_table": out_dict["signature_table"]}
+
+
+def compare(a, b, out, window=None, diameter=None, label_a="A", label_b="B", wall_distance=0,
+            subtract_drift=True, steady_points=0):
+    """Two runs side by side, as ``granmem compare`` (an experiment and a simulation, or two
+    simulations): end-of-cycle displacement and rotation distributions over ``window``
+    (``(first, last)`` cycles; default both runs' last 10 common cycles), their KS and
+    Wasserstein-1 distances, and the paper's figures, written in the folder ``out``.
+    Lengths in grain ``diameter`` ("5mm"; default twice a's median radius);
+    ``wall_distance`` with a unit ("5mm") or in m.
+
+    Returns a dict: ``distances`` (quantity -> ks, wasserstein1_d), ``written`` (files),
+    ``notes`` and ``report`` (the command line's lines)."""
+    return _granmem.compare(os.fspath(a), os.fspath(b), os.fspath(out), _range(window),
+                            diameter, label_a, label_b, _length(wall_distance),
+                            bool(subtract_drift), int(steady_points))

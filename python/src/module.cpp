@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/readout.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/import_table.hpp"
@@ -698,6 +699,46 @@ py::dict readout_py(const std::vector<std::filesystem::path>& states,
   return d;
 }
 
+// ------------------------------------------------------------------------------ compare
+
+py::dict compare_py(const std::filesystem::path& a, const std::filesystem::path& b,
+                    const std::filesystem::path& out, const std::optional<std::string>& window,
+                    const std::optional<std::string>& diameter, const std::string& label_a,
+                    const std::string& label_b, const std::string& wall_distance,
+                    bool subtract_drift, std::size_t steady_points) {
+  const TrajectoryReader run_a(a), run_b(b);
+  CompareOptions o;
+  o.label_a = label_a;
+  o.label_b = label_b;
+  if (window) o.window = parse_int_range(*window, "window");
+  if (diameter) o.diameter = parse_si(*diameter, Dimension::length, "", "diameter");
+  o.wall_distance = parse_si(wall_distance, Dimension::length, "m", "wall_distance");
+  o.subtract_drift = subtract_drift;
+  o.steady_points = steady_points;
+  o.dir = out;
+  Comparison c;
+  {
+    py::gil_scoped_release release;
+    c = compare(run_a, run_b, o);
+  }
+  py::dict distances;
+  for (const auto& [quantity, d] : c.distances) {
+    py::dict q;
+    q["ks"] = d.first;
+    q["wasserstein1_d"] = d.second;
+    distances[py::str(quantity)] = q;
+  }
+  std::vector<std::string> written;
+  for (const auto& p : c.written)
+    written.push_back(p.string());
+  py::dict r;
+  r["distances"] = distances;
+  r["written"] = written;
+  r["notes"] = c.notes;
+  r["report"] = c.Report();
+  return r;
+}
+
 }  // namespace
 }  // namespace granmem::python
 
@@ -746,6 +787,11 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("radius") = py::none());
   m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
+  m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
+        py::arg("window") = py::none(), py::arg("diameter") = py::none(),
+        py::arg("label_a") = CompareOptions{}.label_a,
+        py::arg("label_b") = CompareOptions{}.label_b, py::arg("wall_distance") = "0",
+        py::arg("subtract_drift") = true, py::arg("steady_points") = 0);
   m.def("readout", &readout_py, py::arg("states"), py::arg("out"),
         py::arg("amplitudes") = "0.05%:2.5%:12", py::arg("cycles") = 1,
         py::arg("drive") = "asymmetric", py::arg("wall_motion") = "cosine",

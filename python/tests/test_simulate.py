@@ -94,3 +94,18 @@ def test_readout_in_python_equals_the_command_line(tmp_path, cli):
     assert list(theirs.columns) == list(points.columns)
     for c in points.columns:
         np.testing.assert_allclose(points[c], theirs[c], rtol=1e-12, equal_nan=True, err_msg=c)
+
+
+def test_compare_in_python_equals_the_command_line(tmp_path, cli):
+    for mu, name in [(0.1, "a.h5"), (0.5, "b.h5")]:
+        granmem.simulate(out=tmp_path / name, cycles=4, mu_s=mu, **TINY)
+    ours = granmem.compare(tmp_path / "a.h5", tmp_path / "b.h5", tmp_path / "py",
+                           window=(2, 4), label_a="mu 0.1", label_b="mu 0.5")
+    assert set(ours["distances"]) == {"dr", "rot_disp"}
+    assert 0 < ours["distances"]["dr"]["ks"] <= 1
+    assert any(p.endswith("pdf_displacement.png") for p in ours["written"])
+    cli("compare", "a.h5", "b.h5", "--window", "2:4", "--label-a", "mu 0.1", "--label-b",
+        "mu 0.5", "--out", "cli")
+    a = pd.read_csv(tmp_path / "py" / "distances.csv", comment="#")
+    b = pd.read_csv(tmp_path / "cli" / "distances.csv", comment="#")
+    pd.testing.assert_frame_equal(a, b)

@@ -1,8 +1,8 @@
-#include "comparison_report.hpp"
+#include "granmem/calibration/comparison.hpp"
 
 #include <cmath>
 #include <iomanip>
-#include <iostream>
+#include <sstream>
 
 #include "granmem/calibration/distribution_distance.hpp"
 #include "granmem/calibration/figures.hpp"
@@ -12,7 +12,7 @@
 #include "granmem/core/table.hpp"
 #include "granmem/sim/cyclic_protocol.hpp"
 
-namespace granmem::app {
+namespace granmem {
 namespace {
 
 namespace fs = std::filesystem;
@@ -34,7 +34,7 @@ DisplacementField field_of(const TrajectoryReader& run, const ObservableOptions&
 // The relaxation's power law, or nothing (with a note) when the run is too short for it.
 bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cycle,
                    const std::vector<double>& mean, const PowerLawOptions& options,
-                   std::vector<Relaxation>* out) {
+                   std::vector<Relaxation>* out, std::vector<std::string>* notes) {
   Relaxation r;
   r.label = label;
   for (std::size_t k = 0; k < cycle.size(); ++k) {
@@ -44,7 +44,7 @@ bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cy
   try {
     r.fit = fit_power_law(r.cycle, r.mean, {}, options);
   } catch (const Error& e) {
-    std::cerr << "granmem: note: no power law for " << label << ": " << e.what() << "\n";
+    notes->push_back("no power law for " + label + ": " + e.what());
     return false;
   }
   out->push_back(std::move(r));
@@ -81,6 +81,7 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
   Column& w1 = t.add("wasserstein1", "d");
   std::vector<std::string> names;
   Comparison result;
+  std::ostringstream report;
   auto compare = [&](const std::string& name, const std::vector<double>& u,
                      const std::vector<double>& v) {
     if (u.empty() || v.empty()) return;
@@ -98,8 +99,8 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
     ks_p.values.push_back(ks_p_value(d, su.count, sv.count));
     w1.values.push_back(wasserstein1_distance(u, v));
     result.distances[name] = {d, w1.values.back()};
-    std::cout << std::setprecision(3) << std::setw(10) << name << ": median " << su.median << " vs "
-              << sv.median << " d, KS " << d << ", Wasserstein-1 " << w1.values.back() << " d\n";
+    report << std::setprecision(3) << std::setw(10) << name << ": median " << su.median << " vs "
+           << sv.median << " d, KS " << d << ", Wasserstein-1 " << w1.values.back() << " d\n";
   };
   compare("dr", x.dr, y.dr);
   compare("rot_disp", x.rot_disp, y.rot_disp);
@@ -128,15 +129,17 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
 
   // Fig. 3: relaxation towards the steady state.
   std::vector<Relaxation> trans, rot;
-  relaxation_of(label_a, x.cycle, x.mean_dr, relaxation, &trans);
-  relaxation_of(label_b, y.cycle, y.mean_dr, relaxation, &trans);
+  relaxation_of(label_a, x.cycle, x.mean_dr, relaxation, &trans, &result.notes);
+  relaxation_of(label_b, y.cycle, y.mean_dr, relaxation, &trans, &result.notes);
   if (!trans.empty()) {
     add(plot_relaxation(dir, "relaxation_translation", trans,
                         "mean displacement per cycle - steady state [d]",
                         "Translations: relaxation to the steady state"));
   }
-  if (oa.rotations) relaxation_of(label_a, x.cycle, x.mean_rot_disp, relaxation, &rot);
-  if (ob.rotations) relaxation_of(label_b, y.cycle, y.mean_rot_disp, relaxation, &rot);
+  if (oa.rotations)
+    relaxation_of(label_a, x.cycle, x.mean_rot_disp, relaxation, &rot, &result.notes);
+  if (ob.rotations)
+    relaxation_of(label_b, y.cycle, y.mean_rot_disp, relaxation, &rot, &result.notes);
   if (!rot.empty()) {
     add(plot_relaxation(dir, "relaxation_rotation", rot,
                         "mean rotational displacement per cycle - steady state [d]",
@@ -144,9 +147,9 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
   }
   for (const auto* set : {&trans, &rot}) {
     for (const Relaxation& r : *set) {
-      std::cout << "  relaxation of " << (set == &rot ? "the rotations of " : "") << r.label
-                << ": exponent " << r.fit.exponent << " [" << r.fit.exponent_ci95[0] << ", "
-                << r.fit.exponent_ci95[1] << "]\n";
+      report << "  relaxation of " << (set == &rot ? "the rotations of " : "") << r.label
+             << ": exponent " << r.fit.exponent << " [" << r.fit.exponent_ci95[0] << ", "
+             << r.fit.exponent_ci95[1] << "]\n";
     }
   }
 
@@ -181,7 +184,31 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                       "rotational displacement after a cycle [grain diameter]",
                       "Single-axis and full rotations"));
   }
+  result.report_ = report.str();
   return result;
+}
+
+std::string Comparison::Report() const {
+  return report_;
+}
+
+Comparison compare(const TrajectoryReader& a, const TrajectoryReader& b, const CompareOptions& o) {
+  ObservableOptions observe;
+  observe.motion.subtract_drift = o.subtract_drift;
+  observe.motion.wall_distance = o.wall_distance;
+  observe.diameter = o.diameter ? *o.diameter : median_diameter(a);
+  observe.window = o.window ? *o.window : default_comparison_window(a, b);
+  PowerLawOptions relaxation;
+  relaxation.steady_points = o.steady_points;
+  return compare_runs(a, b, o.label_a, o.label_b, observe, Eigen::Vector3d::Ones(), 0.0, o.dir,
+                      relaxation);
+}
+
+std::pair<std::int64_t, std::int64_t> default_comparison_window(const TrajectoryReader& a,
+                                                                const TrajectoryReader& b) {
+  const std::int64_t last = std::min(a.steps().back(), b.steps().back());
+  const std::int64_t first = std::max(a.steps().front(), b.steps().front()) + 1;
+  return {std::max(first, last - 9), last};
 }
 
 std::vector<fs::path> calibration_figures(const fs::path& dir, const FrictionFit& fit,
@@ -216,4 +243,4 @@ std::vector<fs::path> calibration_figures(const fs::path& dir, const FrictionFit
                      title, true);
 }
 
-}  // namespace granmem::app
+}  // namespace granmem

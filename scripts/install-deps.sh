@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libhdf5-dev hdf5-tools libcli11-dev libopencv-dev libceres-dev libtiff-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libnanoflann-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libfmt-dev libnanoflann-dev nlohmann-json3-dev
   gnuplot-nox
   libopenmpi-dev openmpi-bin
   lammps

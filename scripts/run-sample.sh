@@ -42,8 +42,9 @@ step "4/5 calibrating the DEM's friction on the tracked scans"
 
 step "5/5 result"
 summary="$out/calibration/summary.json"
-fitted=$(sed -n 's/^  "mu_s": \(.*\),$/\1/p' "$summary")
-interval=$(sed -n 's/^  "mu_s_ci95": \[\(.*\)\],$/\1/p' "$summary")
+fitted=$(sed -n 's/^  "mu_s": \(.*\),$/\1/p' "$summary" | xargs printf '%.3g')
+interval=$(sed -n 's/^  "mu_s_ci95": \[\(.*\),\(.*\)\],$/\1 \2/p' "$summary" |
+  xargs printf '%.3g-%.3g')
 echo "sliding friction: fitted $fitted (95% interval $interval), true $TRUE_MU_S" \
   | tee "$out/result.txt"
 echo "figures and tables in $out/calibration/ (pdf_displacement.png, calibration.png, ...)"

@@ -61,7 +61,7 @@ std::vector<std::filesystem::path> run_friction_series(
   for (const FrictionRunSpec& r : runs)
     out.push_back(friction_run_path(options.dir, r));
   std::mutex report;
-  run_pool(runs.size(), {options.parallel}, [&](std::size_t k) {
+  run_pool(runs.size(), {options.parallel, options.stop}, [&](std::size_t k) {
     Simulation sim = start(runs[k]);
     sim.set_threads(1);  // parallel over runs: one thread each
     CyclicOptions c = options.protocol;
@@ -71,11 +71,18 @@ std::vector<std::filesystem::path> run_friction_series(
     c.parameters["calibrate/seed"] = std::to_string(runs[k].seed);
     if (runs[k].mu_r >= 0) c.parameters["calibrate/mu_r"] = std::to_string(runs[k].mu_r);
     ProtocolState state;
-    run_cycles(sim, c, state, [&](const CyclicProgress& p) {
-      if (!progress) return;
-      const std::lock_guard<std::mutex> lock(report);
-      progress(k, p);
-    });
+    const CyclicSummary done = run_cycles(
+        sim, c, state,
+        [&](const CyclicProgress& p) {
+          if (!progress) return;
+          const std::lock_guard<std::mutex> lock(report);
+          progress(k, p);
+        },
+        options.stop);
+    if (done.interrupted) {  // unfinished: the next call runs it again
+      throw Error("stopped during the run at mu_s " + std::to_string(runs[k].mu_s) + ", seed " +
+                  std::to_string(runs[k].seed) + " (finished runs are reused when run again)");
+    }
   });
   return out;
 }

@@ -24,7 +24,8 @@ from ._granmem import Error
 __version__ = _granmem.__version__
 
 __all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
-           "read_tracks", "write_run", "motion", "analyze", "simulate", "readout", "compare"]
+           "read_tracks", "write_run", "motion", "analyze", "simulate", "readout", "compare",
+           "calibrate"]
 
 
 def _frame(columns, units=None, **attrs):
@@ -280,3 +281,37 @@ def compare(a, b, out, window=None, diameter=None, label_a="A", label_b="B", wal
     return _granmem.compare(os.fspath(a), os.fspath(b), os.fspath(out), _range(window),
                             diameter, label_a, label_b, _length(wall_distance),
                             bool(subtract_drift), int(steady_points))
+
+
+def _frictions(value):
+    if value is None or isinstance(value, str):
+        return value
+    return ",".join(repr(float(m)) for m in value)
+
+
+def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_r=None,
+              observables="displacements", only=(), window=None, noise="auto",
+              summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=2,
+              deposit="each", fit_only=False, parallel=0, progress=None, **twin):
+    """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
+    (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
+    ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
+    folder ``out`` (finished runs are reused when called again), and the friction fitted
+    with Ceres so that the twin's ``observables`` match the experiment's over ``window``
+    (``(first, last)`` cycles; default its last 10): "displacements" (the end-of-cycle
+    displacement distribution) or "steady-state" (window means of rotation, packing
+    fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
+    identify friction.
+
+    ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
+    box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``
+    gets dicts with a ``line`` (and a run's ``cycle``, ``cycles``, ...). Ctrl-C stops
+    after the runs under way and is raised. Returns a dict: mu_s, mu_s_ci95 (and mu_r,
+    mu_r_ci95, correlation for a joint fit), true_mu_s / true_mu_r (a pseudo-experiment's,
+    else NaN), simulations, notes, written, report (the command line's lines)."""
+    only = [only] if isinstance(only, str) else list(only)
+    return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
+                              _frictions(mu_r), observables, only, _range(window), str(noise),
+                              summaries, _length(wall_distance), bool(subtract_drift),
+                              int(degree), int(replicas), deposit, bool(fit_only),
+                              int(parallel), twin, progress)

@@ -13,12 +13,15 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <functional>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "granmem/calibration/calibrate.hpp"
 #include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/readout.hpp"
 #include "granmem/core/error.hpp"
@@ -512,8 +515,8 @@ py::dict analyze_py(const std::filesystem::path& path, bool subtract_drift,
 
 // What a job running on another thread reports: a line of what it does, or a cycle done.
 struct Report {
-  std::string line;  // empty for a cycle
-  CyclicProgress cycle;
+  std::string line;      // what the job does, or a run's progress as the CLI prints it
+  CyclicProgress cycle;  // cycles == 0: a line only
 };
 
 // Reports queued by the job's thread, handed to Python on its own (main) thread.
@@ -551,10 +554,8 @@ class ReportQueue {
 
 py::dict report_dict(const Report& r) {
   py::dict d;
-  if (!r.line.empty()) {
-    d["line"] = r.line;
-    return d;
-  }
+  if (!r.line.empty()) d["line"] = r.line;
+  if (r.cycle.cycles == 0) return d;
   d["cycle"] = r.cycle.cycle;
   d["cycles"] = r.cycle.cycles;
   d["particle_steps_per_second"] = r.cycle.particle_steps_per_second;
@@ -604,8 +605,9 @@ auto run_interruptible(Job job, ReportQueue& queue, std::atomic<bool>& stop,
     py::gil_scoped_release release;
     worker.join();
   }
-  if (failure) std::rethrow_exception(failure);
+  // Stopped: the job's own error (e.g. "stopped after 3 of 8 runs") is the interrupt's echo.
   if (interrupt) throw std::move(*interrupt);
+  if (failure) std::rethrow_exception(failure);
   return result;
 }
 
@@ -625,18 +627,31 @@ std::string setting_text(const py::handle& value) {
               std::string(py::str(value.get_type())));
 }
 
+// Keyword arguments (`_` for `-`) onto a job's settings; `allowed` says which names the
+// job takes (`refused`'s % is the name). Returns the names set.
+std::set<std::string> set_settings(const py::dict& given, RunSettings& settings,
+                                   const std::function<bool(const std::string&)>& allowed,
+                                   const std::string& refused) {
+  std::set<std::string> names;
+  for (const auto& [key, value] : given) {
+    std::string name = py::str(key);
+    std::replace(name.begin(), name.end(), '_', '-');
+    if (!allowed(name)) {
+      std::string message = refused;
+      throw Error(message.replace(message.find('%'), 1, name));
+    }
+    settings[name] = setting_text(value);
+    names.insert(name);
+  }
+  return names;
+}
+
 py::dict simulate_py(const py::dict& settings, const std::string& resume,
                      const std::string& start_from, int threads, const py::object& progress) {
   SimulateOptions o;
-  for (const auto& [key, value] : settings) {
-    std::string name = py::str(key);
-    std::replace(name.begin(), name.end(), '_', '-');
-    if (!o.settings.count(name)) {
-      throw Error("simulate: no setting '" + name + "' (see granmem simulate --help)");
-    }
-    o.settings[name] = setting_text(value);
-    o.given.insert(name);
-  }
+  o.given = set_settings(
+      settings, o.settings, [&](const std::string& name) { return o.settings.count(name) > 0; },
+      "simulate: no setting '%' (see granmem simulate --help)");
   o.resume = resume;
   o.start_from = start_from;
   o.threads = threads;
@@ -696,6 +711,73 @@ py::dict readout_py(const std::vector<std::filesystem::path>& states,
   d["diameter"] = s.diameter;
   d["table"] = s.table.string();
   d["signature_table"] = s.signature_table.string();
+  return d;
+}
+
+// ---------------------------------------------------------------------------- calibrate
+
+py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesystem::path& out,
+                      const std::string& mu_s, const std::optional<std::string>& mu_r,
+                      const std::string& observables, const std::vector<std::string>& only,
+                      const std::optional<std::string>& window, const std::string& noise,
+                      const std::string& summaries, const std::string& wall_distance,
+                      bool subtract_drift, int degree, int replicas, const std::string& deposit,
+                      bool fit_only, int parallel, const py::dict& twin,
+                      const py::object& progress) {
+  CalibrateOptions o;
+  o.experiment = experiment;
+  o.out = out;
+  set_settings(twin, o.twin, is_twin_setting,
+               "calibrate: '%' is not a setting of the twin (see granmem calibrate --help)");
+  o.mu_s = parse_frictions(mu_s, "mu_s");
+  if (mu_r) o.mu_r = parse_frictions(*mu_r, "mu_r");
+  if (observables != "displacements" && observables != "steady-state") {
+    throw Error("observables '" + observables + "': expected displacements or steady-state");
+  }
+  o.observables = observables == "steady-state" ? CalibrationObservables::steady_state
+                                                : CalibrationObservables::displacements;
+  o.only = only;
+  if (window) o.window = parse_int_range(*window, "window");
+  o.noise = noise;
+  if (summaries != "pooled" && summaries != "per-cycle") {
+    throw Error("summaries '" + summaries + "': expected pooled or per-cycle");
+  }
+  o.per_cycle = summaries == "per-cycle";
+  o.wall_distance = parse_si(wall_distance, Dimension::length, "m", "wall_distance");
+  o.subtract_drift = subtract_drift;
+  o.degree = degree;
+  o.replicas = replicas;
+  if (deposit != "each" && deposit != "shared") {
+    throw Error("deposit '" + deposit + "': expected each or shared");
+  }
+  o.preparation = deposit == "shared" ? TwinPreparation::shared : TwinPreparation::each;
+  o.fit_only = fit_only;
+  o.parallel = parallel;
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  o.log = [&](const std::string& line) { queue.push({line, {}}); };
+  o.progress = [&](const FrictionRunSpec& run, const CyclicProgress& p) {
+    queue.push({friction_run_progress(run, p), p});
+  };
+  o.stop = &stop;
+  const CalibrateSummary s = run_interruptible([&] { return calibrate(o); }, queue, stop, progress);
+  py::dict d;
+  d["mu_s"] = s.mu_s;
+  d["mu_s_ci95"] = py::make_tuple(s.mu_s_ci95[0], s.mu_s_ci95[1]);
+  if (s.mu_r >= 0) {
+    d["mu_r"] = s.mu_r;
+    d["mu_r_ci95"] = py::make_tuple(s.mu_r_ci95[0], s.mu_r_ci95[1]);
+    d["correlation"] = s.correlation;
+  }
+  d["true_mu_s"] = s.true_mu_s;
+  d["true_mu_r"] = s.true_mu_r;
+  d["simulations"] = s.simulations;
+  d["notes"] = s.notes;
+  std::vector<std::string> written;
+  for (const auto& p : s.written)
+    written.push_back(p.string());
+  d["written"] = written;
+  d["report"] = s.Report();
   return d;
 }
 
@@ -787,6 +869,14 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("radius") = py::none());
   m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
+  m.def("calibrate", &calibrate_py, py::arg("experiment"), py::arg("out"), py::arg("mu_s"),
+        py::arg("mu_r") = py::none(), py::arg("observables") = "displacements",
+        py::arg("only") = std::vector<std::string>{}, py::arg("window") = py::none(),
+        py::arg("noise") = "auto", py::arg("summaries") = "pooled", py::arg("wall_distance") = "0",
+        py::arg("subtract_drift") = true, py::arg("degree") = CalibrateOptions{}.degree,
+        py::arg("replicas") = CalibrateOptions{}.replicas, py::arg("deposit") = "each",
+        py::arg("fit_only") = false, py::arg("parallel") = 0, py::arg("twin") = py::dict(),
+        py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,

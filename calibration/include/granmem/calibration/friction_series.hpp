@@ -1,5 +1,6 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -28,6 +29,9 @@ struct FrictionSeriesOptions {
   std::filesystem::path dir;  // run k goes to friction_run_path(dir, mu_s, seed)
   bool walls_follow = true;   // the walls' and lid's frictions are the grains'
   int parallel = 0;           // runs at once, one thread each; 0: all cores
+  // Set (Python's KeyboardInterrupt): no further run starts, those under way finish, and
+  // run_friction_series throws an Error saying how many were done.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // The physics with the run's sliding (and rolling, where it sets one) friction between

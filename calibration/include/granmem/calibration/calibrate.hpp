@@ -1,0 +1,103 @@
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "granmem/calibration/friction_series.hpp"
+#include "granmem/sim/deposit.hpp"
+#include "granmem/sim/run_settings.hpp"
+#include "granmem/sim/simulate_settings.hpp"
+
+// `granmem calibrate` as a library call: the DEM's friction fitted so that a simulated twin
+// of an experiment matches what was measured (docs/CALIBRATION.md).
+namespace granmem {
+
+// What the fit compares: the end-of-cycle displacement distributions (one friction), or
+// the steady state's window means (rotation, structure, loads; one friction or two).
+enum class CalibrationObservables { displacements, steady_state };
+
+// How the twin's packings are made: each run deposits its own grains at its friction (as
+// the experiment was prepared), or one packing per seed is deposited once (kept in the
+// output folder) and its friction switched before the drive.
+enum class TwinPreparation { each, shared };
+
+struct CalibrateOptions {
+  std::filesystem::path experiment;  // the experiment's trajectory store
+  std::filesystem::path out;         // summary, tables, figures; the twin's runs in out/runs
+  RunSettings twin = default_simulate_settings();  // the twin's `simulate` settings
+  std::vector<double> mu_s{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5};  // frictions simulated
+  // The rolling frictions simulated in a joint fit of mu_s and mu_r (every mu_s x mu_r);
+  // empty: mu_s alone, at the twin's own mu_r.
+  std::vector<double> mu_r;
+  CalibrationObservables observables = CalibrationObservables::displacements;
+  std::vector<std::string> only;  // steady state: these observables only (default all)
+  // Cycles whose observables are compared; default the experiment's last 10.
+  std::optional<std::pair<std::int64_t, std::int64_t>> window;
+  std::string noise = "auto";  // displacements: none, fit, auto, or a value in voxels
+  bool per_cycle = false;      // displacements: each cycle's CDF instead of the window's
+  double wall_distance = 0;    // m: grains closer to a container face are left out
+  bool subtract_drift = true;  // the packing's mean displacement, on both sides
+  int degree = 2;              // of the polynomial in ln mu_s through the runs
+  int replicas = 2;            // packings per friction (seeds seed, seed + 1, ...)
+  TwinPreparation preparation = TwinPreparation::each;
+  bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
+  int parallel = 0;       // runs at once, one thread each; 0: all cores
+  // Lines saying what the calibration does (the twin, reused runs and packings), the
+  // deposition's progress, and each run's progress.
+  std::function<void(const std::string&)> log;
+  DepositProgress deposit_progress;
+  std::function<void(const FrictionRunSpec&, const CyclicProgress&)> progress;
+  // Set (Python's KeyboardInterrupt): no further run starts; finished runs are reused by
+  // the next call.
+  const std::atomic<bool>* stop = nullptr;
+
+  bool joint() const { return !mu_r.empty(); }
+  // Checks the options against each other (Error naming the command line's option);
+  // calibrate() also checks them against the experiment before any run.
+  void validate() const;
+};
+
+struct CalibrateSummary {
+  double mu_s = 0;
+  std::array<double, 2> mu_s_ci95{0, 0};
+  double mu_r = -1;  // the joint fit's; < 0 otherwise
+  std::array<double, 2> mu_r_ci95{0, 0};
+  double correlation = 0;  // of ln mu_s and ln mu_r in the joint fit
+  // The experiment's frictions where granmem simulated it (a pseudo-experiment), else NaN.
+  double true_mu_s = 0, true_mu_r = 0;
+  std::size_t simulations = 0;     // the twin's runs, the one at the fit included
+  std::vector<std::string> notes;  // the comparison's remarks at the fit
+  std::vector<std::filesystem::path> written;
+  // What the command line prints: the comparison at the fit, the fit and its interval.
+  std::string Report() const { return report_; }
+
+ private:
+  std::string report_;
+  friend CalibrateSummary calibrate(const CalibrateOptions& options);
+};
+
+// Simulates the twin's runs not already finished in out/runs (same settings), fits the
+// friction(s) with Ceres, runs the twin at the fit (unless fit_only) and compares it with
+// the experiment; writes summary.json, tables and figures. In an MPI job the runs are
+// shared by the ranks and rank 0 writes and reports.
+CalibrateSummary calibrate(const CalibrateOptions& options);
+
+// A list of frictions as the command line gives it ("0.05,0.1,0.2"), sorted; an Error
+// naming `option` if one is not a positive number or is listed twice.
+std::vector<double> parse_frictions(const std::string& text, const std::string& option);
+
+// Whether a `simulate` setting may be given to the twin: calibrate sets the runs' output,
+// cycles and mu_s itself, and the twin keeps no checkpoints, tracks or samples.
+bool is_twin_setting(const std::string& name);
+
+// A run's progress as the command line prints it.
+std::string friction_run_progress(const FrictionRunSpec& run, const CyclicProgress& p);
+
+}  // namespace granmem

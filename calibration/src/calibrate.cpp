@@ -1,0 +1,798 @@
+#include "granmem/calibration/calibrate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "granmem/calibration/comparison.hpp"
+#include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/calibration/figures.hpp"
+#include "granmem/calibration/friction_fit.hpp"
+#include "granmem/calibration/observable_fit.hpp"
+#include "granmem/core/error.hpp"
+#include "granmem/core/json_file.hpp"
+#include "granmem/core/option_values.hpp"
+#include "granmem/core/statistics.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/units.hpp"
+#include "granmem/sim/checkpoint.hpp"
+#include "granmem/sim/ranks.hpp"
+
+namespace granmem {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Six digits, as labels and messages show a friction.
+std::string number_text(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
+}
+
+// Three digits: the run at the fit gets a file name that a second call finds again.
+double three_digits(double x) {
+  char rounded[32];
+  std::snprintf(rounded, sizeof rounded, "%.3g", x);
+  return std::stod(rounded);
+}
+
+void check_frictions(const std::vector<double>& mu, const std::string& option) {
+  if (mu.empty()) throw Error(option + ": the range of frictions is empty");
+  for (double m : mu)
+    if (!(m > 0) || !std::isfinite(m)) {
+      throw Error(option + ": expected positive frictions, e.g. 0.05,0.1,0.2,0.4");
+    }
+  std::vector<double> sorted = mu;
+  std::sort(sorted.begin(), sorted.end());
+  if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+    throw Error(option + ": a friction is listed twice");
+  }
+}
+
+std::vector<double> sorted(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// Settings that make the protocol: a pseudo-experiment simulated by granmem says what it
+// used, and they must agree with the twin's.
+void check_against_experiment(const RunHeader& experiment, const std::string& file,
+                              const RunSettings& twin, double box) {
+  for (const char* key :
+       {"grains", "box", "diameter", "amplitude", "drive", "wall-motion", "lid-mass",
+        "lid-pressure", "period", "inertial-number", "polydispersity"}) {
+    const auto it = experiment.parameters.find(std::string("simulate/") + key);
+    if (it != experiment.parameters.end() && it->second != twin.at(key)) {
+      throw Error(file + ": the experiment was simulated with --" + key + " " + it->second +
+                  ", the twin has " + twin.at(key) + " (set it in the config's [simulate])");
+    }
+  }
+  if (experiment.box && is_physical_length_unit(experiment.length_unit)) {
+    const double m = metres_per(experiment.length_unit);
+    for (int a = 0; a < 2; ++a) {
+      const double edge = experiment.box->edges(a) * m;
+      if (std::abs(edge - box) > 0.05 * box) {
+        throw Error(file + ": the experiment's box is " + std::to_string(edge * 100) +
+                    " cm wide, the twin's " + std::to_string(box * 100) + " cm (--box)");
+      }
+    }
+  }
+}
+
+// The experiment's friction (mu-s, mu-r) where granmem simulated it (a pseudo-experiment),
+// else NaN.
+double true_friction(const RunHeader& experiment, const std::string& key) {
+  const auto it = experiment.parameters.find("simulate/" + key);
+  if (it == experiment.parameters.end()) return std::nan("");
+  try {
+    return std::stod(it->second);
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
+// The observables' options, the same on both sides, lengths in the twin's grain diameter.
+ObservableOptions observable_options(const CalibrateOptions& o, const TrajectoryReader& experiment,
+                                     const DepositOptions& d) {
+  const RunHeader& h = experiment.header();
+  ObservableOptions observe;
+  observe.diameter = 2 * d.radius;
+  observe.motion.subtract_drift = o.subtract_drift;
+  observe.motion.wall_distance = o.wall_distance;
+  observe.rotations = h.has_axis || h.has_orientation;
+  const auto& steps = experiment.steps();
+  observe.window = o.window ? *o.window
+                            : std::pair<std::int64_t, std::int64_t>{
+                                  std::max(steps.front() + 1, steps.back() - 9), steps.back()};
+  if (observe.window.first < 1) throw Error("--window: cycles start at 1");
+  if (observe.motion.wall_distance > 0) {
+    observe.motion.box = Box{Eigen::Vector3d::Zero(), Eigen::Vector3d(d.box_side, d.box_side, 1e9)};
+    if (!h.box) {
+      throw Error(o.experiment.string() + ": --wall-distance needs the experiment's box");
+    }
+  }
+  return observe;
+}
+
+// The experiment's observables, measured in its own container.
+CycleObservables measured_observables(const TrajectoryReader& experiment, ObservableOptions o) {
+  o.motion.box.reset();
+  return cycle_observables(experiment, o);
+}
+
+// A steady-state fit asked by name for what the experiment does not measure: refused
+// before the twin runs.
+void check_only(const CalibrateOptions& o, const SteadyState& measured) {
+  for (const std::string& name : o.only) {
+    if (std::isfinite(measured[name])) continue;
+    std::string has;
+    for (std::size_t k = 0; k < measured.names.size(); ++k)
+      if (std::isfinite(measured.values[k])) has += (has.empty() ? "" : ", ") + measured.names[k];
+    throw Error("--only: '" + name + "' is not measured in " + o.experiment.string() + " (it has " +
+                has + ")");
+  }
+}
+
+// The displacement fit's options; the locating noise from --noise and the experiment's voxel.
+FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const RunHeader& h,
+                                            double diameter, std::string* noise_model) {
+  FrictionFitOptions fit;
+  fit.degree = o.degree;
+  fit.per_cycle = o.per_cycle;
+  const std::string noise = o.noise == "auto" ? (h.voxel_size ? "fit" : "none") : o.noise;
+  *noise_model = noise;
+  if (noise == "none") return fit;
+  if (!h.voxel_size) {
+    throw Error("--noise " + noise + ": the experiment has no voxel size (not from scans)");
+  }
+  fit.noise_shape = *h.voxel_size * metres_per(h.length_unit) / diameter;
+  fit.noise = noise == "fit" ? NoiseModel::fitted : NoiseModel::fixed;
+  if (noise != "fit") fit.noise_sigma = parse_quantity(noise, "--noise").value;
+  return fit;
+}
+
+// Everything the calibration's stages share: the experiment, the twin's physics and
+// protocol, and how to run the twin (reusing what a stopped call finished).
+class Twin {
+ public:
+  Twin(const CalibrateOptions& options, const TrajectoryReader& experiment)
+      : o_(options), experiment_(experiment), settings_(options.twin) {
+    if (o_.joint()) settings_["mu-r"] = number_text(sorted(o_.mu_r).front());  // each run its own
+    physics_ = physics_from(settings_);
+    deposit_ = deposit_from(settings_);
+    deposit_.validate();  // before any work or output
+    physics_.validate("calibrate", deposit_.radius * (1 - deposit_.polydispersity));
+    check_against_experiment(experiment.header(), o_.experiment.string(), settings_,
+                             deposit_.box_side);
+    observe = observable_options(o_, experiment, deposit_);
+    measured = measured_observables(experiment, observe);
+    series_ = series_options();
+    for (int r = 0; r < o_.replicas; ++r)
+      seeds_.push_back(deposit_.seed + std::uint64_t(r));
+  }
+
+  ObservableOptions observe;
+  CycleObservables measured;
+
+  const CalibrateOptions& options() const { return o_; }
+  const TrajectoryReader& experiment() const { return experiment_; }
+  const RunSettings& settings() const { return settings_; }
+  std::uint64_t seed() const { return deposit_.seed; }
+
+  // Every friction (pair) at every seed.
+  std::vector<FrictionRunSpec> design() const {
+    std::vector<FrictionRunSpec> specs;
+    for (std::uint64_t seed : seeds_)
+      for (double m : sorted(o_.mu_s))
+        for (double r : o_.joint() ? sorted(o_.mu_r) : std::vector<double>{-1})
+          specs.push_back({m, seed, r});
+    return specs;
+  }
+
+  void announce() const {
+    note_experiment_seed();
+    std::ostringstream line;
+    std::string mu;
+    for (double m : sorted(o_.mu_s))
+      mu += (mu.empty() ? "" : ",") + number_text(m);
+    line << "calibrate: twin of " << o_.experiment.string() << ": " << deposit_.grains
+         << " grains, box " << deposit_.box_side * 100
+         << " cm, A = " << series_.protocol.drive.amplitude * 100 << " cm, cycles 1-"
+         << series_.protocol.cycles << " (window " << observe.window.first << ":"
+         << observe.window.second << "), mu_s " << mu << ", " << o_.replicas
+         << " packing(s) from seed " << deposit_.seed << ", deposited "
+         << (o_.preparation == TwinPreparation::each ? "at each friction" : "once per seed");
+    say(line.str());
+  }
+
+  // Shared packings: one per seed, kept in the output folder so that a second call
+  // reuses them.
+  void prepare_shared_packings() {
+    if (o_.preparation != TwinPreparation::shared) return;
+    for (std::uint64_t seed : seeds_) {
+      const fs::path path = o_.out / ("packing_seed_" + std::to_string(seed) + ".checkpoint.h5");
+      RunSettings settings = settings_;
+      settings["seed"] = std::to_string(seed);
+      if (fs::exists(path)) {
+        ProtocolState state;
+        shared_.emplace(seed, read_checkpoint(path, &state));
+        if (state.settings != settings) {
+          throw Error(path.string() + ": deposited with other settings; remove it or " +
+                      "choose another --out");
+        }
+        say("reusing the packing of " + path.string());
+        continue;
+      }
+      say("depositing " + std::to_string(deposit_.grains) + " grains (seed " +
+          std::to_string(seed) + ")");
+      DepositOptions pour = deposit_;
+      pour.seed = seed;
+      shared_.emplace(seed, deposit(pour, physics_, nullptr, o_.deposit_progress));
+      ProtocolState state;
+      state.settings = settings;
+      write_checkpoint(path, shared_.at(seed), state);
+    }
+  }
+
+  // Runs those of `specs` not already finished in the runs folder with the same settings.
+  void run(const std::vector<FrictionRunSpec>& specs) const {
+    std::vector<FrictionRunSpec> todo;
+    for (const FrictionRunSpec& spec : specs)
+      if (!finished_run(path(spec), series_.protocol.parameters, series_.protocol.cycles)) {
+        todo.push_back(spec);
+      }
+    if (todo.size() < specs.size()) {
+      say("reusing " + std::to_string(specs.size() - todo.size()) + " finished runs in " +
+          series_.dir.string());
+    }
+    if (todo.empty()) return;
+    const int at_once =
+        series_.parallel > 0 ? series_.parallel : int(std::thread::hardware_concurrency());
+    say(std::to_string(todo.size()) + " runs, " + std::to_string(at_once) + " at once");
+    auto start = [&](const FrictionRunSpec& spec) {
+      if (o_.preparation == TwinPreparation::shared) {
+        return with_frictions(shared_.at(spec.seed), spec, series_.walls_follow);
+      }
+      return deposit_at_friction(deposit_, physics_, spec, series_.walls_follow);
+    };
+    run_friction_series(todo, series_, start, [&](std::size_t k, const CyclicProgress& p) {
+      if (o_.progress) o_.progress(todo[k], p);
+    });
+  }
+
+  fs::path path(const FrictionRunSpec& spec) const { return friction_run_path(series_.dir, spec); }
+
+  void say(const std::string& line) const {
+    if (o_.log) o_.log(line);
+  }
+
+ private:
+  FrictionSeriesOptions series_options() const {
+    FrictionSeriesOptions series;
+    series.dir = o_.out / "runs";
+    series.walls_follow = wall_friction_follows(settings_);
+    if (o_.joint() && series.walls_follow != (settings_.at("wall-mu-r") == "same")) {
+      throw Error(
+          "--fit mu_s,mu_r: give the walls' sliding and rolling frictions alike (both "
+          "'same', following the grains', or both fixed)");
+    }
+    series.parallel = o_.parallel;
+    series.stop = o_.stop;
+    series.protocol.cycles = observe.window.second;
+    series.protocol.drive = drive_from(settings_, physics_, deposit_.box_side, deposit_.box_side,
+                                       deposit_.lid_mass, deposit_.radius);
+    for (const auto& [key, value] : settings_)
+      series.protocol.parameters["simulate/" + key] = value;
+    series.protocol.parameters["calibrate/deposit"] =
+        o_.preparation == TwinPreparation::each ? "each" : "shared";
+    series.protocol.validate(deposit_.box_side, physics_.dt);
+    return series;
+  }
+
+  void note_experiment_seed() const {
+    const auto seed = experiment_.header().parameters.find("simulate/seed");
+    if (seed == experiment_.header().parameters.end()) return;
+    std::uint64_t s = 0;
+    try {
+      s = std::stoull(seed->second);
+    } catch (const std::exception&) {
+      return;
+    }
+    if (std::count(seeds_.begin(), seeds_.end(), s)) {
+      say("note: the twin's seeds include the experiment's (" + seed->second +
+          "): one twin run pours the experiment's own grains");
+    }
+  }
+
+  const CalibrateOptions& o_;
+  const TrajectoryReader& experiment_;
+  RunSettings settings_;
+  PhysicsOptions physics_;
+  DepositOptions deposit_;
+  FrictionSeriesOptions series_;
+  std::vector<std::uint64_t> seeds_;
+  std::map<std::uint64_t, Simulation> shared_;
+};
+
+std::size_t simulations_with(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+                             const FrictionRunSpec& best) {
+  const bool simulated = std::any_of(specs.begin(), specs.end(), [&](const auto& r) {
+    return r.mu_s == best.mu_s && r.seed == best.seed && r.mu_r == best.mu_r;
+  });
+  return specs.size() + (twin.options().fit_only || simulated ? 0 : 1);
+}
+
+// The twin at the fit (unless fit_only) compared with the experiment: the distances, the
+// comparison's figures and lines.
+Comparison compare_at_fit(const Twin& twin, const FrictionRunSpec& best,
+                          Eigen::Vector3d noise_shape, double noise_sigma) {
+  if (twin.options().fit_only) return {};
+  twin.run({best});
+  if (!mpi_ranks().root()) return {};
+  std::string label = "DEM mu_s = " + number_text(best.mu_s);
+  if (best.mu_r >= 0) label += ", mu_r = " + number_text(best.mu_r);
+  return compare_runs(twin.experiment(), TrajectoryReader(twin.path(best)), "experiment", label,
+                      twin.observe, noise_shape, noise_sigma, twin.options().out);
+}
+
+// The members every summary.json ends with.
+void add_protocol(JsonObject& j, const Twin& twin) {
+  j["window"] = {twin.observe.window.first, twin.observe.window.second};
+  j["experiment"] = twin.options().experiment.string();
+  j["settings"] = twin.settings();
+}
+
+std::vector<SteadyStateRun> twin_steady_states(const Twin& twin,
+                                               const std::vector<FrictionRunSpec>& specs) {
+  std::vector<SteadyStateRun> runs;
+  for (const FrictionRunSpec& spec : specs) {
+    const TrajectoryReader r(twin.path(spec));
+    runs.push_back(
+        {spec.mu_s, spec.seed, steady_state(r, cycle_observables(r, twin.observe)), spec.mu_r});
+  }
+  return runs;
+}
+
+// The steady-state fit's outputs: the runs' window means (steady_state_runs.csv), the
+// figure, and the summary's per-observable part.
+struct SteadyStateOutputs {
+  std::vector<fs::path> written;
+  std::vector<std::string> notes;  // observables that still drift across the window
+  JsonObject observables;          // the "observables" member of summary.json
+};
+
+void write_steady_state_runs(const fs::path& out, const ObservableFit& fit,
+                             const std::vector<SteadyStateRun>& runs) {
+  Table t;
+  Column& mu = t.add("mu_s");
+  Column& seed = t.add("seed", "", true);
+  std::vector<Column*> value;
+  for (const std::string& name : fit.names)
+    value.push_back(&t.add(name));
+  for (const SteadyStateRun& r : runs) {
+    mu.values.push_back(r.mu_s);
+    seed.values.push_back(double(r.seed));
+    for (std::size_t k = 0; k < fit.names.size(); ++k)
+      value[k]->values.push_back(r.state[fit.names[k]]);
+  }
+  write_csv(t, out / "steady_state_runs.csv",
+            {"the twin's steady state: window means per run (rot_disp in grain diameters, "
+             "wall force in N)"});
+}
+
+SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableFit& fit,
+                                          const SteadyState& experiment,
+                                          const std::vector<SteadyStateRun>& runs,
+                                          double true_mu_s) {
+  SteadyStateOutputs o;
+  write_steady_state_runs(out, fit, runs);
+  o.written.push_back(out / "steady_state_runs.csv");
+  std::map<std::uint64_t, int> packing;
+  for (const SteadyStateRun& r : runs)
+    packing.emplace(r.seed, int(packing.size()));
+  std::vector<ObservablePanel> panels;
+  for (std::size_t k = 0; k < fit.names.size(); ++k) {
+    const std::string& name = fit.names[k];
+    ObservablePanel p;
+    p.label = steady_state_label(name);
+    for (const SteadyStateRun& r : runs) {
+      p.run_mu_s.push_back(r.mu_s);
+      p.run_value.push_back(r.state[name]);
+      p.run_packing.push_back(packing.at(r.seed));
+    }
+    p.curve_mu_s = fit.curve_mu_s;
+    p.curve = fit.curve[k];
+    p.experiment = experiment[name];
+    p.experiment_error = fit.scatter[k];
+    panels.push_back(std::move(p));
+    double twin_drift = 0;
+    for (const SteadyStateRun& r : runs)
+      twin_drift += r.state.drift_of(name) / double(runs.size());
+    // The twin's mean over its runs says it for the protocol; one run's drift is noisy.
+    if (std::abs(twin_drift) > fit.scatter[k]) {
+      o.notes.push_back(name + " still changes by " + number_text(twin_drift) +
+                        " across the window (the twin's runs' mean; one packing's scatter " +
+                        number_text(fit.scatter[k]) + "): not yet a steady state");
+    }
+    o.observables[name] = {
+        {"experiment", experiment[name]},       {"drift_over_window", experiment.drift_of(name)},
+        {"twin_drift_over_window", twin_drift}, {"model_at_fit", fit.model[k]},
+        {"packing_scatter", fit.scatter[k]},    {"log_mu_s_resolution", fit.resolution[k]}};
+  }
+  char title[160];
+  std::snprintf(title, sizeof title, "steady-state fit: mu_s = %.3g (95%% %.3g-%.3g)%s", fit.mu_s,
+                fit.mu_s_ci95[0], fit.mu_s_ci95[1],
+                std::isfinite(true_mu_s) ? (", true " + number_text(true_mu_s)).c_str() : "");
+  const auto figure =
+      plot_observable_fit(out, "observable_fit", panels, fit.mu_s, fit.mu_s_ci95, true_mu_s, title);
+  o.written.insert(o.written.end(), figure.begin(), figure.end());
+  return o;
+}
+
+std::string observables_line(const Twin& twin, const std::vector<std::string>& names,
+                             const std::vector<double>* resolution) {
+  std::ostringstream line;
+  line << std::setprecision(3) << "  steady state over cycles " << twin.observe.window.first << "-"
+       << twin.observe.window.second << ":";
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    line << (k ? ", " : " ") << names[k];
+    if (resolution) line << " (+-" << (*resolution)[k] << " in ln mu_s)";
+  }
+  return line.str() + "\n";
+}
+
+// The run at the fit's comparison: its lines first in the report, its notes and files kept.
+void add_comparison(CalibrateSummary& s, std::ostream& report, const Comparison& c) {
+  s.notes.insert(s.notes.end(), c.notes.begin(), c.notes.end());
+  s.written.insert(s.written.end(), c.written.begin(), c.written.end());
+  report << c.Report();
+}
+
+void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+                      CalibrateSummary& s, std::ostream& report) {
+  const CalibrateOptions& o = twin.options();
+  const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
+  ObservableFitOptions fo;
+  fo.degree = o.degree;
+  const SteadyState measured = steady_state(twin.experiment(), twin.measured);
+  const ObservableFit fit = fit_friction_to_steady_state(measured, runs, fo, o.only);
+  const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed()};
+  const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
+  if (!mpi_ranks().root()) return;
+  add_comparison(s, report, compared);
+  s.mu_s = fit.mu_s;
+  s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
+  s.simulations = simulations_with(twin, specs, best);
+  const SteadyStateOutputs written =
+      write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s);
+  s.written.insert(s.written.end(), written.written.begin(), written.written.end());
+  JsonObject j;
+  j["mu_s"] = fit.mu_s;
+  j["mu_s_ci95"] = s.mu_s_ci95;
+  j["mu_s_true"] = s.true_mu_s;
+  j["mu_s_interval_method"] = fit.method;
+  j["log_mu_s_sigma"] = fit.log_mu_s_sigma;
+  j["gls_sigma"] = fit.gls_sigma;
+  j["cross_validated_sigma"] = fit.cross_validated_sigma;
+  j["chi2"] = fit.chi2;
+  j["dof"] = fit.dof;
+  j["n_simulations"] = s.simulations;
+  j["replicas"] = o.replicas;
+  j["observables"] = written.observables;
+  add_protocol(j, twin);
+  write_json(o.out / "summary.json", j);
+  report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
+         << " - " << fit.mu_s_ci95[1] << ", " << s.simulations << " simulations)";
+  if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
+  report << "\n" << observables_line(twin, fit.names, &fit.resolution);
+  report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
+         << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
+         << " in ln mu_s on " << fit.cross_validations << " runs\n";
+  for (const std::string& note : written.notes)
+    report << "  note: " << note << "\n";
+  report << "wrote " << (o.out / "summary.json").string() << ", steady_state_runs.csv, "
+         << written.written.size() - 1 + compared.written.size() << " figure files\n";
+}
+
+void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, CalibrateSummary& s,
+               std::ostream& report) {
+  const CalibrateOptions& o = twin.options();
+  const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
+  ObservableFitOptions fo;
+  fo.degree = o.degree;
+  const SteadyState measured = steady_state(twin.experiment(), twin.measured);
+  const JointObservableFit fit = fit_frictions_to_steady_state(measured, runs, fo, o.only);
+  const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
+  const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
+  if (!mpi_ranks().root()) return;
+  add_comparison(s, report, compared);
+  s.mu_s = fit.mu_s;
+  s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
+  s.mu_r = fit.mu_r;
+  s.mu_r_ci95 = {fit.mu_r_ci95[0], fit.mu_r_ci95[1]};
+  s.correlation = fit.correlation;
+  s.simulations = simulations_with(twin, specs, best);
+  std::vector<double> run_s, run_r;
+  for (const FrictionRunSpec& r : specs) {
+    run_s.push_back(r.mu_s);
+    run_r.push_back(r.mu_r);
+  }
+  char title[200];
+  std::snprintf(title, sizeof title,
+                "joint fit: mu_s = %.3g (%.3g-%.3g), mu_r = %.3g (%.3g-%.3g), correlation %.2f",
+                fit.mu_s, fit.mu_s_ci95[0], fit.mu_s_ci95[1], fit.mu_r, fit.mu_r_ci95[0],
+                fit.mu_r_ci95[1], fit.correlation);
+  const auto figure = plot_joint_region(o.out, "joint_fit", run_s, run_r, fit.region95,
+                                        {fit.mu_s, fit.mu_r}, {s.true_mu_s, s.true_mu_r}, title);
+  s.written.insert(s.written.end(), figure.begin(), figure.end());
+  JsonObject j;
+  j["mu_s"] = fit.mu_s;
+  j["mu_s_ci95"] = s.mu_s_ci95;
+  j["mu_r"] = fit.mu_r;
+  j["mu_r_ci95"] = s.mu_r_ci95;
+  j["correlation"] = fit.correlation;
+  j["log_covariance"] = fit.log_covariance;
+  j["mu_s_true"] = s.true_mu_s;
+  j["mu_r_true"] = s.true_mu_r;
+  j["interval_method"] = fit.method;
+  j["chi2"] = fit.chi2;
+  j["dof"] = fit.dof;
+  j["region95"] = fit.region95;
+  j["n_simulations"] = s.simulations;
+  j["replicas"] = o.replicas;
+  j["observables"] = fit.names;
+  add_protocol(j, twin);
+  write_json(o.out / "summary.json", j);
+  report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
+         << " - " << fit.mu_s_ci95[1] << ")";
+  if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
+  report << "\nmu_r = " << fit.mu_r << "  (95% interval " << fit.mu_r_ci95[0] << " - "
+         << fit.mu_r_ci95[1] << ")";
+  if (std::isfinite(s.true_mu_r)) report << "  true " << s.true_mu_r;
+  report << "\n  correlation of ln mu_s and ln mu_r " << fit.correlation << ", " << s.simulations
+         << " simulations\n"
+         << observables_line(twin, fit.names, nullptr) << "  chi2 " << fit.chi2 << " for "
+         << fit.dof << " dof; cross-validated " << fit.cross_validated_sigma[0] << " (mu_s), "
+         << fit.cross_validated_sigma[1] << " (mu_r) in ln on " << fit.cross_validations
+         << " runs\n"
+         << "wrote " << (o.out / "summary.json").string() << ", "
+         << figure.size() + compared.written.size() << " figure files\n";
+}
+
+// The displacement fit's tables: each run's smoothed CDF at the experiment's deciles, and
+// each run's displacement summary (the last row: the run at the fit).
+void write_displacement_tables(const fs::path& out, const FrictionFit& fit,
+                               const std::vector<FrictionRunSpec>& specs,
+                               const std::vector<FrictionRun>& runs, const FrictionRunSpec& best,
+                               const CycleObservables& at_fit) {
+  Table t;
+  Column& cycle = t.add("cycle", "", true);
+  Column& level = t.add("threshold_dr", "d");
+  Column& exp_cdf = t.add("experiment_cdf");
+  Column& exp_err = t.add("experiment_error");
+  Column& model = t.add("fit_cdf");
+  std::vector<Column*> per_run;
+  for (const FrictionRunSpec& run : specs)
+    per_run.push_back(
+        &t.add("cdf_mu_s_" + number_text(run.mu_s) + "_seed_" + std::to_string(run.seed)));
+  for (std::size_t j = 0; j < fit.thresholds.size(); ++j) {
+    cycle.values.push_back(double(fit.threshold_cycle[j]));
+    level.values.push_back(fit.thresholds[j]);
+    exp_cdf.values.push_back(fit.experiment_cdf[j]);
+    exp_err.values.push_back(fit.experiment_error[j]);
+    model.values.push_back(fit.model_cdf[j]);
+    for (std::size_t k = 0; k < specs.size(); ++k)
+      per_run[k]->values.push_back(fit.run_cdf[k][j]);
+  }
+  write_csv(t, out / "cdf_summaries.csv",
+            {"smoothed CDF of the end-of-cycle displacement dr (grain diameters) at the "
+             "experiment's deciles (of the window, cycle 0, or of each cycle), per simulated "
+             "mu_s (with the fitted locating noise)"});
+  Table r;
+  Column& m = r.add("mu_s");
+  Column& seed = r.add("seed", "", true);
+  Column& n = r.add("n", "", true);
+  Column& mean = r.add("mean_dr", "d");
+  Column& median = r.add("median_dr", "d");
+  Column& mean_rot = r.add("mean_rot_disp", "d");
+  for (std::size_t k = 0; k <= runs.size(); ++k) {
+    const CycleObservables& o = k < runs.size() ? runs[k].observables : at_fit;
+    const Summary s = summarize(o.dr);
+    m.values.push_back(k < runs.size() ? runs[k].mu_s : best.mu_s);
+    seed.values.push_back(double(k < runs.size() ? specs[k].seed : best.seed));
+    n.values.push_back(double(s.count));
+    mean.values.push_back(s.mean);
+    median.values.push_back(s.median);
+    mean_rot.values.push_back(summarize(o.rot_disp).mean);
+  }
+  write_csv(r, out / "runs.csv",
+            {"per simulated mu_s (the last row: at the fit): end-of-cycle displacements "
+             "over the window, grain diameters"});
+}
+
+void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+                       const FrictionFitOptions& fit_options, const std::string& noise_model,
+                       CalibrateSummary& s, std::ostream& report) {
+  const CalibrateOptions& o = twin.options();
+  std::vector<FrictionRun> runs;
+  for (const FrictionRunSpec& spec : specs)
+    runs.push_back(
+        {spec.mu_s, cycle_observables(TrajectoryReader(twin.path(spec)), twin.observe), spec.seed});
+  const FrictionFit fit = fit_friction(twin.measured, runs, fit_options);
+
+  // The twin at the fitted friction: what the distances and the figures compare, with the
+  // fitted locating noise.
+  const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed()};
+  twin.run({best});
+  if (!mpi_ranks().root()) return;  // in an MPI job, rank 0 writes the results
+  const TrajectoryReader best_run(twin.path(best));
+  const CycleObservables at_fit = cycle_observables(best_run, twin.observe);
+  s.mu_s = fit.mu_s;
+  s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
+  s.simulations = simulations_with(twin, specs, best);
+  write_displacement_tables(o.out, fit, specs, runs, best, at_fit);
+  s.written.push_back(o.out / "cdf_summaries.csv");
+  s.written.push_back(o.out / "runs.csv");
+  std::vector<double> run_mu;
+  for (const FrictionRunSpec& spec : specs)
+    run_mu.push_back(spec.mu_s);
+  const std::vector<fs::path> figures = calibration_figures(o.out, fit, run_mu);
+  s.written.insert(s.written.end(), figures.begin(), figures.end());
+  const Comparison compared = compare_runs(twin.experiment(), best_run, "experiment",
+                                           "DEM mu_s = " + number_text(best.mu_s), twin.observe,
+                                           fit_options.noise_shape, fit.noise_sigma, o.out);
+  add_comparison(s, report, compared);
+  auto distance = [&](const std::string& q, bool wasserstein) {
+    const auto it = compared.distances.find(q);
+    if (it == compared.distances.end()) return std::nan("");
+    return wasserstein ? it->second.second : it->second.first;
+  };
+  const double ks = distance("dr", false), w1 = distance("dr", true);
+
+  JsonObject j;
+  j["mu_s"] = fit.mu_s;
+  j["mu_s_ci95"] = s.mu_s_ci95;
+  j["mu_s_interval_method"] = fit.method;
+  j["n_simulations"] = s.simulations;
+  j["replicas"] = o.replicas;
+  j["deposit"] = o.preparation == TwinPreparation::each ? "each" : "shared";
+  j["summaries"] = o.per_cycle ? "per-cycle" : "pooled";
+  j["mu_s_simulated"] = sorted(o.mu_s);
+  j["converged"] = fit.converged;
+  j["chi2"] = fit.chi2;
+  j["dof"] = fit.dof;
+  j["overdispersion"] = fit.overdispersion;
+  j["noise_model"] = noise_model;
+  j["noise_sigma_voxel"] = fit.noise_sigma;
+  j["noise_sigma_error"] = fit.noise_sigma_error;
+  j["distances_at_fit"] = {{"ks_dr", ks},
+                           {"wasserstein1_dr", w1},
+                           {"ks_rot_disp", distance("rot_disp", false)},
+                           {"wasserstein1_rot_disp", distance("rot_disp", true)},
+                           {"length_unit", "grain diameter"}};
+  add_protocol(j, twin);
+  write_json(o.out / "summary.json", j);
+
+  const std::vector<double> mu = sorted(o.mu_s);
+  report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
+         << " - " << fit.mu_s_ci95[1] << ", " << s.simulations << " simulations"
+         << (fit.converged ? "" : ", fit NOT converged") << ")\n"
+         << "  at the fit: KS " << ks << ", Wasserstein-1 " << w1 << " d (end-of-cycle dr); chi2 "
+         << fit.chi2 << " for " << fit.dof << " dof; realization scatter x" << fit.overdispersion
+         << "\n";
+  if (fit.mu_s_ci95[0] < mu.front() || fit.mu_s_ci95[1] > mu.back()) {
+    report << "  the interval reaches beyond the simulated frictions (" << mu.front() << "-"
+           << mu.back() << "): these displacements pin mu_s down only loosely (a larger "
+           << "packing or a longer window would)\n";
+  }
+  if (fit.noise_sigma > 0) {
+    report << "  locating noise " << fit.noise_sigma << " +- " << fit.noise_sigma_error
+           << " voxel\n";
+  }
+  report << "wrote " << (o.out / "summary.json").string() << ", runs.csv, cdf_summaries.csv, "
+         << figures.size() + compared.written.size() << " figure files\n";
+}
+
+}  // namespace
+
+void CalibrateOptions::validate() const {
+  check_frictions(mu_s, "--mu-s");
+  if (joint()) check_frictions(mu_r, "--mu-r");
+  const bool steady = observables == CalibrationObservables::steady_state;
+  if (fit_only && !steady) {
+    throw Error(
+        "--fit-only: only with --observables steady-state (the displacement fit "
+        "compares its distributions at the fit)");
+  }
+  if (joint() && !steady) {
+    throw Error("--fit mu_s,mu_r: the joint fit is on --observables steady-state");
+  }
+  if (joint() && mu_r.size() < 3) throw Error("--mu-r: the joint fit needs at least 3 values");
+  if (replicas < 1) throw Error("--replicas: at least one packing");
+  if (degree < 1) throw Error("--degree: at least 1");
+  // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
+  const std::size_t needed = std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);
+  if (mu_s.size() < needed) {
+    throw Error("--mu-s: " + std::to_string(mu_s.size()) + " frictions; the fit needs at least " +
+                std::to_string(needed) + " (degree " + std::to_string(degree) + " + 1" +
+                (replicas > 1 ? "" : ", and one more to measure the runs' scatter") + ")");
+  }
+  if (noise != "auto" && noise != "fit" && noise != "none") {
+    const Quantity q = parse_quantity(noise, "--noise");
+    if (!q.unit.empty() || !(q.value >= 0)) {
+      throw Error("--noise '" + noise + "': expected none, fit, auto or voxels (0.05)");
+    }
+  }
+  if (!(wall_distance >= 0)) throw Error("--wall-distance: expected a length >= 0");
+  if (window && window->first < 1) throw Error("--window: cycles start at 1");
+}
+
+CalibrateSummary calibrate(const CalibrateOptions& options) {
+  options.validate();
+  const TrajectoryReader experiment(options.experiment);
+  Twin twin(options, experiment);  // every setting checked before any output
+  CalibrateSummary s;
+  s.true_mu_s = true_friction(experiment.header(), "mu-s");
+  s.true_mu_r = true_friction(experiment.header(), "mu-r");
+  const bool steady = options.observables == CalibrationObservables::steady_state;
+  if (steady) check_only(options, steady_state(experiment, twin.measured));
+  std::string noise_model;
+  const FrictionFitOptions fit_options =
+      displacement_fit_options(options, experiment.header(), twin.observe.diameter, &noise_model);
+  fs::create_directories(options.out / "runs");
+  twin.announce();
+  twin.prepare_shared_packings();
+  const std::vector<FrictionRunSpec> specs = twin.design();
+  twin.run(specs);
+  std::ostringstream report;
+  if (options.joint()) {
+    fit_joint(twin, specs, s, report);
+  } else if (steady) {
+    fit_steady_state(twin, specs, s, report);
+  } else {
+    fit_displacements(twin, specs, fit_options, noise_model, s, report);
+  }
+  s.report_ = report.str();
+  return s;
+}
+
+std::vector<double> parse_frictions(const std::string& text, const std::string& option) {
+  if (trim(text).empty()) throw Error(option + ": the range of frictions is empty");
+  std::vector<double> mu;
+  for (const Quantity& q : parse_quantity_list(text, option)) {
+    if (!q.unit.empty() || !(q.value > 0) || !std::isfinite(q.value)) {
+      throw Error(option + " '" + text + "': expected positive frictions, e.g. 0.05,0.1,0.2,0.4");
+    }
+    mu.push_back(q.value);
+  }
+  std::sort(mu.begin(), mu.end());
+  if (mu.empty()) throw Error(option + ": the range of frictions is empty");
+  if (std::adjacent_find(mu.begin(), mu.end()) != mu.end()) {
+    throw Error(option + " '" + text + "': a friction is listed twice");
+  }
+  return mu;
+}
+
+bool is_twin_setting(const std::string& name) {
+  static const std::set<std::string> calibrate_sets{
+      "out",  "checkpoint", "checkpoint-every",  "cycles",
+      "mu-s", "track",      "samples-per-cycle", "full-compression"};
+  return default_simulate_settings().count(name) && !calibrate_sets.count(name);
+}
+
+std::string friction_run_progress(const FrictionRunSpec& run, const CyclicProgress& p) {
+  char rate[32];
+  std::snprintf(rate, sizeof rate, "%.2e", p.particle_steps_per_second);
+  return "mu_s " + number_text(run.mu_s) + (run.mu_r >= 0 ? " mu_r " + number_text(run.mu_r) : "") +
+         " seed " + std::to_string(run.seed) + ": cycle " + std::to_string(p.cycle) + "/" +
+         std::to_string(p.cycles) + "  " + rate + " particle-steps/s  " +
+         std::to_string(std::llround(p.seconds_left)) + " s left";
+}
+
+}  // namespace granmem

@@ -1,0 +1,63 @@
+"""granmem.calibrate: the command line's friction fit from Python, stopped and resumed."""
+import json
+
+import pytest
+
+import granmem
+
+# A tiny pseudo-experiment and its twin's protocol: 60 grains in a 2 cm box, 3 cycles.
+TWIN = dict(grains=60, box="2cm", lid_mass="0.2kg", amplitude="5%", period="0.1s")
+TWIN_FLAGS = ["--grains", "60", "--box", "2cm", "--lid-mass", "0.2kg", "--amplitude", "5%",
+              "--period", "0.1s"]
+FIT = dict(mu_s=[0.05, 0.1, 0.2, 0.4], window=(2, 3), observables="steady-state",
+           fit_only=True, parallel=2)
+
+
+@pytest.fixture
+def experiment(tmp_path):
+    granmem.simulate(out=tmp_path / "exp.h5", cycles=3, seed=7, mu_s=0.2, threads=1, **TWIN)
+    return tmp_path / "exp.h5"
+
+
+def test_calibrate_in_python_equals_the_command_line(tmp_path, cli, experiment):
+    lines = []
+    fit = granmem.calibrate(experiment, tmp_path / "py", progress=lines.append, **FIT, **TWIN)
+    assert fit["true_mu_s"] == 0.2  # a pseudo-experiment says its friction
+    lo, hi = fit["mu_s_ci95"]
+    assert lo <= fit["mu_s"] <= hi
+    assert fit["simulations"] == 8  # 4 frictions x 2 packings, none at the fit (fit_only)
+    assert any("cycle" in r for r in lines) and any("8 runs" in r.get("line", "") for r in lines)
+    out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.05,0.1,0.2,0.4",
+              "--window", "2:3", "--observables", "steady-state", "--fit-only", *TWIN_FLAGS)
+    def fitted(report):  # the lines but the last, which names the output folder
+        return report.splitlines()[:-1]
+    assert fitted(out) == fitted(fit["report"]) and "mu_s = " in out
+    ours = json.loads((tmp_path / "py" / "summary.json").read_text())
+    theirs = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert ours["mu_s"] == theirs["mu_s"] == fit["mu_s"]
+    assert ours["mu_s_ci95"] == theirs["mu_s_ci95"]
+    assert ours["settings"] == theirs["settings"]
+
+
+def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):
+    def stop_at_first_report(report):
+        if "cycle" in report:
+            raise KeyboardInterrupt  # as Ctrl-C would
+
+    with pytest.raises(KeyboardInterrupt):
+        granmem.calibrate(experiment, tmp_path / "cal", progress=stop_at_first_report,
+                          **FIT, **TWIN)
+    lines = []
+    fit = granmem.calibrate(experiment, tmp_path / "cal", progress=lines.append, **FIT, **TWIN)
+    assert fit["simulations"] == 8
+    assert fit["mu_s_ci95"][0] <= fit["mu_s"] <= fit["mu_s_ci95"][1]
+
+
+def test_bad_calibrations_are_one_clear_error(tmp_path, experiment):
+    with pytest.raises(granmem.Error, match="'cycles' is not a setting of the twin"):
+        granmem.calibrate(experiment, tmp_path / "x", cycles=3, **FIT)
+    with pytest.raises(granmem.Error, match="mu-s: 2 frictions; the fit needs at least 3"):
+        granmem.calibrate(experiment, tmp_path / "x", mu_s=[0.1, 0.2], **TWIN)
+    with pytest.raises(granmem.Error, match="twin has 3%"):
+        granmem.calibrate(experiment, tmp_path / "x", **{**FIT, **TWIN, "amplitude": "3%"})
+    assert not (tmp_path / "x").exists()  # refused before any output

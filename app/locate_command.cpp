@@ -97,7 +97,7 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
   const std::int64_t voxels = stack.nx * stack.ny * stack.nz;
 
   LocateSummary sum;
-  Detections d = locate(stack, o, &sum);
+  Detections d = locate(std::move(stack), o, &sum);  // not needed after
   d.frame = frame;
   d.source = path;
   // Positions in the whole stack's frame, not the region's.

@@ -215,7 +215,7 @@ py::tuple locate_py(const py::array& array, const std::string& diameter,
   Detections d;
   {
     py::gil_scoped_release release;
-    d = locate(stack, o, &sum);
+    d = locate(std::move(stack), o, &sum);
   }
   d.frame = frame;
   py::dict summary;

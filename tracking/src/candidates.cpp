@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
+#include "granmem/core/cell_grid.hpp"
 #include "granmem/core/point_index.hpp"
 #include "granmem/tracking/illumination.hpp"
 
@@ -75,16 +75,12 @@ Volume ball_mean(const Volume& vol, const Eigen::Array3d& semi) {
   return out;
 }
 
-// A hash of a grid cell's integer coordinates.
-std::int64_t cell_key(const Eigen::Vector3i& c) {
-  return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
-}
-
 }  // namespace
 
 std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const CandidateOptions& o,
                                              const std::vector<HoledSphere>* found,
-                                             const Eigen::Vector3d& voxel_size) {
+                                             const Eigen::Vector3d& voxel_size,
+                                             const std::vector<Eigen::Vector3d>* tried) {
   // Grain fraction binned by b voxels along each axis, b keeping six or more bins per
   // diameter: less memory and work, and neighbours still apart.
   Eigen::Array3i bin;
@@ -190,44 +186,44 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
   std::vector<Peak> peaks;
   for (auto& f : by_slice)
     peaks.insert(peaks.end(), f.begin(), f.end());
-  if (found) {
-    // Within half a diameter of a found grain, in units of the diameter along each axis.
-    Vectors3 scaled(Eigen::Index(found->size()), 3);
-    for (std::size_t k = 0; k < found->size(); ++k) {
+  // Within `reach` diameters (along each axis) of one of `centres` (physical).
+  const auto drop_near = [&](const std::vector<Eigen::Vector3d>& centres, double reach) {
+    if (centres.empty()) return;
+    Vectors3 scaled(Eigen::Index(centres.size()), 3);
+    for (std::size_t k = 0; k < centres.size(); ++k) {
       scaled.row(Eigen::Index(k)) =
-          (*found)[k].centre.cwiseQuotient(voxel_size).cwiseQuotient(o.diameter).transpose();
+          centres[k].cwiseQuotient(voxel_size).cwiseQuotient(o.diameter).transpose();
     }
     const PointIndex index(std::move(scaled));
     PointIndex::Hits hits;
-    const auto explained = [&](const Peak& p) {
-      index.within(p.x.cwiseQuotient(o.diameter), 0.5, hits);
+    const auto near = [&](const Peak& p) {
+      index.within(p.x.cwiseQuotient(o.diameter), reach, hits);
       return !hits.empty();
     };
-    peaks.erase(std::remove_if(peaks.begin(), peaks.end(), explained), peaks.end());
+    peaks.erase(std::remove_if(peaks.begin(), peaks.end(), near), peaks.end());
+  };
+  if (found) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const HoledSphere& g : *found)
+      centres.push_back(g.centre);
+    drop_near(centres, 0.5);
   }
+  if (tried) drop_near(*tried, 0.25);
   std::stable_sort(peaks.begin(), peaks.end(),
                    [](const Peak& a, const Peak& b) { return a.response > b.response; });
 
   // Strongest first; a grid of cells one separation wide finds the close ones.
   const Eigen::Vector3d separation = o.min_separation * o.diameter;
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid;
+  CellGrid grid(separation);
   std::vector<Eigen::Vector3d> kept;
   for (const Peak& p : peaks) {
-    const Eigen::Vector3i cell = p.x.cwiseQuotient(separation).array().floor().cast<int>();
     bool close = false;
-    for (int dz = -1; dz <= 1 && !close; ++dz) {
-      for (int dy = -1; dy <= 1 && !close; ++dy) {
-        for (int dx = -1; dx <= 1 && !close; ++dx) {
-          const auto it = grid.find(cell_key(cell + Eigen::Vector3i(dx, dy, dz)));
-          if (it == grid.end()) continue;
-          for (std::size_t k : it->second) {
-            if ((kept[k] - p.x).cwiseQuotient(separation).squaredNorm() < 1) close = true;
-          }
-        }
-      }
-    }
+    grid.near(p.x, 1, [&](std::size_t k) {
+      close = (kept[k] - p.x).cwiseQuotient(separation).squaredNorm() < 1;
+      return !close;
+    });
     if (close) continue;
-    grid[cell_key(cell)].push_back(kept.size());
+    grid.insert(p.x, kept.size());
     kept.push_back(p.x);
   }
   return kept;

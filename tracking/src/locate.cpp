@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <unordered_map>
+#include <functional>
+#include <memory>
 
+#include "granmem/core/cell_grid.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/units.hpp"
@@ -17,39 +19,6 @@
 
 namespace granmem {
 namespace {
-
-// Grains near a point, from a grid of cells one diameter wide (physical coordinates).
-class GrainGrid {
- public:
-  GrainGrid(const std::vector<Eigen::Vector3d>& centres, double cell) : cell_(cell) {
-    for (std::size_t i = 0; i < centres.size(); ++i)
-      cells_[key(index(centres[i]))].push_back(i);
-  }
-  template <class F>
-  void near(const Eigen::Vector3d& p, int reach, F&& visit) const {
-    const Eigen::Vector3i c = index(p);
-    for (int dz = -reach; dz <= reach; ++dz) {
-      for (int dy = -reach; dy <= reach; ++dy) {
-        for (int dx = -reach; dx <= reach; ++dx) {
-          const auto it = cells_.find(key(c + Eigen::Vector3i(dx, dy, dz)));
-          if (it == cells_.end()) continue;
-          for (std::size_t i : it->second)
-            visit(i);
-        }
-      }
-    }
-  }
-
- private:
-  Eigen::Vector3i index(const Eigen::Vector3d& p) const {
-    return (p / cell_).array().floor().cast<int>();
-  }
-  static std::int64_t key(const Eigen::Vector3i& c) {
-    return (std::int64_t(c.z()) * 100003 + c.y()) * 100019 + c.x();
-  }
-  double cell_;
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
-};
 
 // The hole's direction, roughly: the principal axis of the fluid seen inside the grain
 // (within 0.75 R). Where the hole is seen bright (fluid >= 0.5: at 12 voxels and up), of
@@ -167,194 +136,51 @@ void LocateOptions::validate() const {
   require(search_rounds >= 0, "search_rounds must be 0 or more");
 }
 
-Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) {
-  o.validate();
-  auto clock = std::chrono::steady_clock::now();
-  auto lap = [&clock] {
-    const auto now = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(now - clock).count();
-    clock = now;
-    return s;
-  };
-  LocateSummary sum;
-  const std::string& where = stack.source.empty() ? std::string("stack") : stack.source;
-  if (!(o.diameter > 0)) throw Error(where + ": the grain diameter must be positive");
-  const Eigen::Vector3d vs = stack.voxel_size.value_or(Eigen::Vector3d::Ones());
-  const Eigen::Vector3d dims(double(stack.nx), double(stack.ny), double(stack.nz));
-  const double diameter = o.diameter * vs.x();  // physical
-  const Eigen::Vector3d diameter_voxels = Eigen::Vector3d::Constant(diameter).cwiseQuotient(vs);
-  if ((diameter_voxels.array() > dims.array()).any()) {
-    throw Error(where + ": grain diameter " + std::to_string(o.diameter) +
-                " voxels is larger than the stack (" + std::to_string(stack.nx) + " x " +
-                std::to_string(stack.ny) + " x " + std::to_string(stack.nz) + ")");
+namespace {
+
+// The grains of one normalised scan being located, stage by stage: candidates, model fits
+// pass after pass with searches for missed grains between them, the holes' axes, and the
+// detections. Lengths physical (voxels where the scan has no voxel size).
+class GrainLocator {
+ public:
+  GrainLocator(const Stack& stack, const LocateOptions& o)
+      : stack_(stack),
+        o_(o),
+        vs_(stack.voxel_size.value_or(Eigen::Vector3d::Ones())),
+        diameter_(o.diameter * vs_.x()),
+        radius_(0.5 * diameter_),
+        hole_(o.dark_grains ? o.hole_fraction : 0.0) {
+    candidate_options_.diameter = diameter_voxels(o, vs_);
   }
-  const double radius = 0.5 * diameter;
-  const double hole = o.dark_grains ? o.hole_fraction : 0.0;
 
-  IlluminationOptions light;
-  light.diameter = diameter_voxels[o.beam_axis];
-  light.dark_grains = o.dark_grains;
-  light.beam_axis = o.beam_axis;
-  if (o.correct_illumination) {
-    normalize_illumination(stack, light);
-  } else {
-    normalize_levels(stack, light);
-  }
-  sum.seconds_illumination = lap();
+  // The candidates of the scan (maxima of the smoothed grain fraction).
+  void find() { add_candidates(find_candidates(stack_, candidate_options_)); }
 
-  CandidateOptions co;
-  co.diameter = diameter_voxels;
-  std::vector<Candidate> grains;
-  auto add_candidates = [&](const std::vector<Eigen::Vector3d>& found_at) {
-    for (const Eigen::Vector3d& c : found_at) {
-      Candidate g;
-      g.found_at = c.cwiseProduct(vs);
-      g.start.centre = g.found_at;
-      g.start.radius = radius;
-      g.start.blur = 0.6 * vs.x();
-      g.start.hole = hole;
-      grains.push_back(g);
-    }
-  };
-  add_candidates(find_candidates(stack, co));
-  sum.seconds_candidates = lap();
-
-  // A converged fit of the nominal size and a blur under the radius: a blur that wide
-  // smears a grain into its neighbours, and such a fit explains something else (its next
-  // window, three blurs wide, would be huge). Only such fits are started from again.
-  auto shaped_like_a_grain = [&](const GrainFit& f) {
-    return f.converged && f.sphere.centre.allFinite() &&
-           std::abs(f.sphere.radius / radius - 1) <= o.radius_tolerance && f.sphere.blur < radius;
-  };
-  // One fit of every active grain that `refit` selects: with the voxels nearer another
-  // grain left out or, once the neighbours are known, with them in the model. Each reads
-  // its neighbours as the last pass left them, so the order of the fits does not matter.
-  // The active grains (only those fitted, with `fitted_only`) and a grid to find them by.
-  struct Neighbours {
-    std::vector<std::size_t> ids;
-    GrainGrid grid;
-  };
-  auto neighbours = [&](bool fitted_only) {
-    std::vector<Eigen::Vector3d> centres;
-    std::vector<std::size_t> ids;
-    for (std::size_t i = 0; i < grains.size(); ++i) {
-      if (grains[i].active && (grains[i].fitted || !fitted_only)) {
-        centres.push_back(grains[i].start.centre);
-        ids.push_back(i);
-      }
-    }
-    return Neighbours{std::move(ids), GrainGrid(centres, diameter)};
-  };
-  auto fit_pass = [&](bool model_neighbours, auto refit) {
-    const Neighbours known = neighbours(model_neighbours);
-    const std::vector<std::size_t>& ids = known.ids;
-    const GrainGrid& grid = known.grid;
-    std::vector<GrainFit> fits(grains.size());
-#pragma omp parallel
-    {
-      GrainWindow window;
-      std::vector<const HoledSphere*> near;
-#pragma omp for schedule(dynamic, 16)
-      for (std::size_t i = 0; i < grains.size(); ++i) {
-        if (!grains[i].active || !refit(i)) continue;
-        const HoledSphere& s = grains[i].start;
-        const double reach = s.radius + 3 * s.blur + 0.5 * vs.maxCoeff();
-        near.clear();
-        grid.near(s.centre, 2, [&](std::size_t k) {
-          const HoledSphere& other = grains[ids[k]].start;
-          if (ids[k] != i && (other.centre - s.centre).norm() < 2 * reach + radius) {
-            near.push_back(&other);
-          }
-        });
-        window_of(stack, s, reach, near, model_neighbours, vs, window);
-        HoledSphere from = s;
-        GrainFitOptions fo;
-        fo.fit_axis = o.fit_axis;
-        if (!grains[i].fitted && hole > 0 && window.points.size() > 20) {
-          // The hole's direction is read from the fluid inside the grain, which needs the
-          // centre first: a sphere without hole fitted from the candidate gives it.
-          HoledSphere plain = s;
-          plain.hole = 0;
-          const GrainFit sphere = fit_grain(window, plain, fo);
-          if (sphere.converged && (sphere.sphere.centre - s.centre).norm() < 0.5 * s.radius) {
-            from.centre = sphere.sphere.centre;
-          }
-          from.axis = hole_direction(window.points, window.intensity, from.centre, s.radius);
-        }
-        if (window.points.size() > 20) fits[i] = fit_grain(window, from, fo);
-      }
-    }
-    for (std::size_t i = 0; i < grains.size(); ++i) {
-      if (!grains[i].active || !refit(i)) continue;
-      Candidate& g = grains[i];
-      g.fit = fits[i];
-      g.fitted = true;
-      if (shaped_like_a_grain(g.fit)) g.start = g.fit.sphere;
-    }
-  };
-
-  // Keeps the fits that look like grains; of two that found the same grain, the better.
-  auto quality = [](const GrainFit& f) {
-    const double contrast = f.fluid - f.grain;
-    return contrast > 0 ? std::clamp(1 - f.rms / contrast, 0.0, 1.0) : 0.0;
-  };
-  auto select = [&] {
-    std::vector<std::size_t> order;
-    for (std::size_t i = 0; i < grains.size(); ++i)
-      if (grains[i].active) order.push_back(i);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return quality(grains[a].fit) > quality(grains[b].fit);
-    });
-    std::vector<Eigen::Vector3d> kept;
-    for (std::size_t i : order) {
-      const GrainFit& f = grains[i].fit;
-      const bool grain_like = shaped_like_a_grain(f) && f.fluid - f.grain >= o.min_contrast &&
-                              (f.sphere.centre - grains[i].found_at).norm() < diameter;
-      const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const auto& c) {
-        return (c - f.sphere.centre).norm() < 0.5 * diameter;
-      });
-      grains[i].active = grain_like && !duplicate;
-      if (grains[i].active) kept.push_back(f.sphere.centre);
-    }
-  };
-  auto all = [](std::size_t) { return true; };
-
-  fit_pass(false, all);
-  select();
-  // Then, with the neighbours in the model, pass after pass; before each, grains the
-  // candidates missed (a maximum merged with a neighbour's, a fit drawn onto a neighbour)
-  // are looked for in what the found grains leave unexplained, so that no fit is pulled
-  // into an unexplained grain. Each fit reads its neighbours as the last pass left them:
-  // `passes` refit every grain; further searches only the new grains and their neighbours.
-  const int rounds = std::max(o.passes - 1, o.search_rounds);
-  for (int round = 0; round < rounds; ++round) {
-    std::vector<HoledSphere> found;
-    for (const Candidate& g : grains)
-      if (g.active) found.push_back(g.start);
-    const std::vector<Eigen::Vector3d> hidden = round < o.search_rounds
-                                                    ? find_candidates(stack, co, &found, vs)
-                                                    : std::vector<Eigen::Vector3d>{};
-    const bool refit_all = round < o.passes - 1;
-    if (hidden.empty() && !refit_all) break;
-    const std::size_t first_new = grains.size();
-    add_candidates(hidden);
-    const auto is_new = [&](std::size_t i) { return i >= first_new; };
-    fit_pass(true, is_new);
-    // The grains whose windows reach a new one.
-    std::vector<Eigen::Vector3d> new_centres;
-    for (std::size_t i = first_new; i < grains.size(); ++i)
-      new_centres.push_back(grains[i].start.centre);
-    const GrainGrid new_grid(new_centres, diameter);
-    const auto near_new = [&](std::size_t i) {
-      bool near = is_new(i);
-      new_grid.near(grains[i].start.centre, 2, [&](std::size_t k) {
-        near |= (new_centres[k] - grains[i].start.centre).norm() < 2 * diameter;
-      });
-      return near;
-    };
-    fit_pass(true, [&](std::size_t i) { return refit_all || near_new(i); });
+  // A first fit of every candidate with its neighbours' voxels left out, then, with the
+  // neighbours in the model, pass after pass; before each, grains the candidates missed
+  // (a maximum merged with a neighbour's, a fit drawn onto a neighbour) are looked for in
+  // what the found grains leave unexplained, so that no fit is pulled into an unexplained
+  // grain. Each fit reads its neighbours as the last pass left them: `passes` refit every
+  // grain; further searches only the new grains and their neighbours.
+  void fit() {
+    fit_pass(false, [](std::size_t) { return true; });
     select();
+    const int rounds = std::max(o_.passes - 1, o_.search_rounds);
+    for (int round = 0; round < rounds; ++round) {
+      const std::vector<Eigen::Vector3d> hidden =
+          round < o_.search_rounds ? search_unexplained() : std::vector<Eigen::Vector3d>{};
+      const bool refit_all = round < o_.passes - 1;
+      if (hidden.empty() && !refit_all) break;
+      const std::size_t first_new = grains_.size();
+      add_candidates(hidden);
+      const auto is_new = [&](std::size_t i) { return i >= first_new; };
+      fit_pass(true, is_new);
+      const auto near_new = reaching_new(first_new);
+      fit_pass(true, [&](std::size_t i) { return refit_all || near_new(i); });
+      select();
+    }
   }
+
   // The hole's axis, refitted on each grain's inner voxels with a blur of its own across
   // and along z (hole_axis.hpp): the model fits' axes tilt on scans of coarser slices. The
   // neighbours' grain fractions are added to the model's (the blur is linear, the grains
@@ -364,119 +190,362 @@ Detections locate(Stack& stack, const LocateOptions& o, LocateSummary* summary) 
   // refits') and the model fits' radius shortfall (the median of refit - model fit
   // radius), and then every grain with its neighbours seen through that blur, their radius
   // so corrected.
-  if (hole > 0 && o.fit_axis) {
+  void refit_axes() {
+    if (hole_ == 0 || !o_.fit_axis) return;
     const Neighbours known = neighbours(true);
-    const std::vector<std::size_t>& ids = known.ids;
-    const GrainGrid& grid = known.grid;
     HoleAxisOptions axis_options;
-    const std::size_t stride = std::max<std::size_t>(1, ids.size() / 64);
-    std::vector<HoleAxisFit> refits(ids.size());
-    double across = 0, along_z = 0, shortfall = 0;
-    for (int round = 0; round < 2; ++round) {
-      const std::size_t step = round == 0 ? stride : 1;
-#pragma omp parallel
-      {
-        GrainWindow window;
-        std::vector<HoledSphere> near;  // the neighbours as this round sees them
-#pragma omp for schedule(dynamic, 4)
-        for (std::size_t k = 0; k < ids.size(); k += step) {
-          const GrainFit& f = grains[ids[k]].fit;
-          // Within the refit's radius (the model fit's runs small): ~1 voxel more of the
-          // hole at PSF 1.0 / 1.0 / 1.5 voxel (p95 2.96 -> 2.80 deg at d = 12).
-          const double reach = axis_options.within * (f.sphere.radius + shortfall);
-          const double blur = std::max(across, along_z);
-          near.clear();
-          grid.near(f.sphere.centre, 1, [&](std::size_t j) {
-            HoledSphere s = grains[ids[j]].start;
-            s.radius += shortfall;
-            const double reach_j = s.radius + 5 * (round == 0 ? s.blur : blur);
-            if (j != k && (s.centre - f.sphere.centre).norm() < reach + reach_j) near.push_back(s);
-          });
-          const auto others = [&](const Eigen::Vector3d& p) {
-            double sum = 0;
-            for (const HoledSphere& s : near) {
-              if (round == 0) {
-                if ((p - s.centre).norm() < s.radius + 4 * s.blur) sum += s.value(p);
-              } else if ((p - s.centre).norm() < s.radius + 5 * blur) {
-                sum += blurred_grain_fraction(p, s, across, along_z);
-              }
-            }
-            return sum;
-          };
-          inner_window(stack, f.sphere.centre, reach, others, vs, window);
-          refits[k] = fit_hole_axis(window, f, axis_options);
-        }
-      }
-      if (round == 1) break;
-      std::vector<double> a, z, r, b, g;
-      for (std::size_t k = 0; k < ids.size(); k += stride) {
-        if (!refits[k].converged) continue;
-        const GrainFit& f = grains[ids[k]].fit;
-        a.push_back(refits[k].blur_across);
-        z.push_back(refits[k].blur_along_z);
-        r.push_back(refits[k].radius - f.sphere.radius);
-        b.push_back(refits[k].fluid - f.fluid);
-        g.push_back(refits[k].grain - f.grain);
-      }
-      if (a.empty()) break;  // no refit converged: the sample's refits stand
-      const auto median = [](std::vector<double>& v) { return quantile_in_place(v, 0.5); };
-      across = median(a);
-      along_z = median(z);
-      shortfall = median(r);
-      // Every grain's refit starts there: fewer iterations than from the model fit.
-      axis_options.start = {across, along_z, shortfall, median(b), median(g)};
+    const std::size_t stride = std::max<std::size_t>(1, known.ids.size() / 64);
+    std::vector<HoleAxisFit> refits(known.ids.size());
+    AxisBlur blur;
+    refit_axes(known, stride, blur, axis_options, refits);
+    if (sample_blur(known.ids, refits, stride, &blur, &axis_options)) {
+      refit_axes(known, 1, blur, axis_options, refits);
     }
-    for (std::size_t k = 0; k < ids.size(); ++k) {
+    for (std::size_t k = 0; k < known.ids.size(); ++k) {
       const HoleAxisFit& r = refits[k];
-      GrainFit& f = grains[ids[k]].fit;
+      GrainFit& f = grains_[known.ids[k]].fit;
       if (r.converged && std::isfinite(r.sigma)) {
         f.sphere.axis = r.axis;
         f.axis_sigma = r.sigma;
       }
     }
   }
-  sum.seconds_fits = lap();
 
-  sum.candidates = grains.size();
-  Detections d;
-  d.has_axis = hole > 0;
-  d.source = stack.source;
-  d.length_unit = stack.voxel_size ? stack.unit : "voxel";
-  d.voxel_size = stack.voxel_size;
-  std::vector<double> contact_radius;
-  constexpr double kDegree = 3.14159265358979323846 / 180;
-  for (const Candidate& g : grains) {
-    if (!g.active) continue;
-    const GrainFit& f = g.fit;
-    const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs);
-    // The fitted radius runs small (the blur's curvature shift, ~0.2 voxel at 12 voxels):
-    // with it, grains cut by a fraction of a voxel were not flagged. Not below the nominal.
-    const double outer = std::max(f.sphere.radius, radius);
-    const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(outer).cwiseQuotient(vs);
-    const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
-                      ((voxel + r_voxels).array() > dims.array() - 0.5).any();
-    sum.on_edge += edge;
-    contact_radius.push_back(outer);
-    // Physical units when the voxel size is known, voxels otherwise (vs = 1 then).
-    d.add(f.sphere.centre, f.sphere.radius, quality(f), edge);
-    if (!d.has_axis || edge) continue;  // a cut grain's hole may be cut too: no axis
-    const std::size_t row = d.size() - 1;
-    if (o.fit_axis) {
-      // Seen when the fit pins it down: its standard error under the limit.
-      if (!(f.axis_sigma <= o.max_axis_sigma_degrees * kDegree)) continue;
-      d.axis.row(Eigen::Index(row)) = f.sphere.axis.transpose();
-      d.axis_quality[row] = 1 / (1 + f.axis_sigma / kDegree);
-    } else {
-      d.axis.row(Eigen::Index(row)) = lab_hole_axis(stack, f.sphere.centre, radius, vs).transpose();
+  // The grains taken, with their quality, edge flags, axes and hole contacts.
+  Detections detections(LocateSummary& sum) const {
+    sum.candidates = grains_.size();
+    Detections d;
+    d.has_axis = hole_ > 0;
+    d.source = stack_.source;
+    d.length_unit = stack_.voxel_size ? stack_.unit : "voxel";
+    d.voxel_size = stack_.voxel_size;
+    const Eigen::Vector3d dims(double(stack_.nx), double(stack_.ny), double(stack_.nz));
+    std::vector<double> contact_radius;
+    constexpr double kDegree = 3.14159265358979323846 / 180;
+    for (const Candidate& g : grains_) {
+      if (!g.active) continue;
+      const GrainFit& f = g.fit;
+      const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs_);
+      // The fitted radius runs small (the blur's curvature shift, ~0.2 voxel at 12
+      // voxels): with it, grains cut by a fraction of a voxel were not flagged. Not below
+      // the nominal.
+      const double outer = std::max(f.sphere.radius, radius_);
+      const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(outer).cwiseQuotient(vs_);
+      const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
+                        ((voxel + r_voxels).array() > dims.array() - 0.5).any();
+      sum.on_edge += edge;
+      contact_radius.push_back(outer);
+      // Physical units when the voxel size is known, voxels otherwise (vs = 1 then).
+      d.add(f.sphere.centre, f.sphere.radius, quality(f), edge);
+      if (!d.has_axis || edge) continue;  // a cut grain's hole may be cut too: no axis
+      const std::size_t row = d.size() - 1;
+      if (o_.fit_axis) {
+        // Seen when the fit pins it down: its standard error under the limit.
+        if (!(f.axis_sigma <= o_.max_axis_sigma_degrees * kDegree)) continue;
+        d.axis.row(Eigen::Index(row)) = f.sphere.axis.transpose();
+        d.axis_quality[row] = 1 / (1 + f.axis_sigma / kDegree);
+      } else {
+        d.axis.row(Eigen::Index(row)) =
+            lab_hole_axis(stack_, f.sphere.centre, radius_, vs_).transpose();
+      }
+    }
+    if (d.has_axis) {
+      HoleContactOptions contacts;
+      contacts.hole_fraction = hole_;
+      d.hole_contact = hole_contacts(d.position, contact_radius, d.axis, contacts);
+    }
+    sum.rejected = sum.candidates - d.size();
+    sum.located = d.size();
+    return d;
+  }
+
+ private:
+  // The active grains (only those fitted, with `fitted_only`) and a grid to find them by.
+  struct Neighbours {
+    std::vector<std::size_t> ids;
+    CellGrid grid;
+  };
+  // The scan's blur and the model fits' radius shortfall, from a sample of axis refits.
+  struct AxisBlur {
+    double across = 0, along_z = 0, shortfall = 0;
+    bool sampled = false;
+  };
+
+  static Eigen::Vector3d diameter_voxels(const LocateOptions& o, const Eigen::Vector3d& vs) {
+    return Eigen::Vector3d::Constant(o.diameter * vs.x()).cwiseQuotient(vs);
+  }
+
+  // How well a fit explains its voxels: 1 - rms / contrast, in [0, 1].
+  static double quality(const GrainFit& f) {
+    const double contrast = f.fluid - f.grain;
+    return contrast > 0 ? std::clamp(1 - f.rms / contrast, 0.0, 1.0) : 0.0;
+  }
+
+  void add_candidates(const std::vector<Eigen::Vector3d>& found_at) {
+    for (const Eigen::Vector3d& c : found_at) {
+      Candidate g;
+      g.found_at = c.cwiseProduct(vs_);
+      g.start.centre = g.found_at;
+      g.start.radius = radius_;
+      g.start.blur = 0.6 * vs_.x();
+      g.start.hole = hole_;
+      grains_.push_back(g);
     }
   }
-  if (d.has_axis) {
-    HoleContactOptions contacts;
-    contacts.hole_fraction = hole;
-    d.hole_contact = hole_contacts(d.position, contact_radius, d.axis, contacts);
+
+  // Candidates in what the grains found so far leave unexplained, but where a fit found
+  // less contrast than a grain has: the dark blur of a small pore between grains, say,
+  // which would be found again and again and hide the grains around it.
+  std::vector<Eigen::Vector3d> search_unexplained() const {
+    std::vector<HoledSphere> found;
+    std::vector<Eigen::Vector3d> tried;
+    for (const Candidate& g : grains_) {
+      if (g.active) {
+        found.push_back(g.start);
+      } else if (g.fitted && g.fit.fluid - g.fit.grain < o_.min_contrast) {
+        tried.push_back(g.found_at);
+      }
+    }
+    return find_candidates(stack_, candidate_options_, &found, vs_, &tried);
   }
-  sum.rejected = sum.candidates - d.size();
-  sum.located = d.size();
+
+  // Whether grain i's window reaches one of the grains from `first_new` on.
+  std::function<bool(std::size_t)> reaching_new(std::size_t first_new) const {
+    auto centres = std::make_shared<std::vector<Eigen::Vector3d>>();
+    for (std::size_t i = first_new; i < grains_.size(); ++i)
+      centres->push_back(grains_[i].start.centre);
+    auto grid = std::make_shared<CellGrid>(*centres, diameter_);
+    return [this, centres, grid, first_new](std::size_t i) {
+      bool near = i >= first_new;
+      grid->near(grains_[i].start.centre, 2, [&](std::size_t k) {
+        near |= ((*centres)[k] - grains_[i].start.centre).norm() < 2 * diameter_;
+      });
+      return near;
+    };
+  }
+
+  // A converged fit of the nominal size and a blur under the radius: a blur that wide
+  // smears a grain into its neighbours, and such a fit explains something else (its next
+  // window, three blurs wide, would be huge). Only such fits are started from again.
+  bool shaped_like_a_grain(const GrainFit& f) const {
+    return f.converged && f.sphere.centre.allFinite() &&
+           std::abs(f.sphere.radius / radius_ - 1) <= o_.radius_tolerance &&
+           f.sphere.blur < radius_;
+  }
+
+  Neighbours neighbours(bool fitted_only) const {
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<std::size_t> ids;
+    for (std::size_t i = 0; i < grains_.size(); ++i) {
+      if (grains_[i].active && (grains_[i].fitted || !fitted_only)) {
+        centres.push_back(grains_[i].start.centre);
+        ids.push_back(i);
+      }
+    }
+    return Neighbours{std::move(ids), CellGrid(centres, diameter_)};
+  }
+
+  // One fit of grain i: with the voxels nearer another grain left out or, once the
+  // neighbours are known, with them in the model.
+  GrainFit fit_one(std::size_t i, bool model_neighbours, const Neighbours& known,
+                   GrainWindow& window, std::vector<const HoledSphere*>& near) const {
+    const HoledSphere& s = grains_[i].start;
+    const double reach = s.radius + 3 * s.blur + 0.5 * vs_.maxCoeff();
+    near.clear();
+    known.grid.near(s.centre, 2, [&](std::size_t k) {
+      const HoledSphere& other = grains_[known.ids[k]].start;
+      if (known.ids[k] != i && (other.centre - s.centre).norm() < 2 * reach + radius_) {
+        near.push_back(&other);
+      }
+    });
+    window_of(stack_, s, reach, near, model_neighbours, vs_, window);
+    if (window.points.size() <= 20) return {};
+    HoledSphere from = s;
+    GrainFitOptions fo;
+    fo.fit_axis = o_.fit_axis;
+    if (!grains_[i].fitted && hole_ > 0) {
+      // The hole's direction is read from the fluid inside the grain, which needs the
+      // centre first: a sphere without hole fitted from the candidate gives it.
+      HoledSphere plain = s;
+      plain.hole = 0;
+      const GrainFit sphere = fit_grain(window, plain, fo);
+      if (sphere.converged && (sphere.sphere.centre - s.centre).norm() < 0.5 * s.radius) {
+        from.centre = sphere.sphere.centre;
+      }
+      from.axis = hole_direction(window.points, window.intensity, from.centre, s.radius);
+    }
+    return fit_grain(window, from, fo);
+  }
+
+  // One fit of every active grain that `refit` selects. Each reads its neighbours as the
+  // last pass left them, so the order of the fits does not matter.
+  template <class Refit>
+  void fit_pass(bool model_neighbours, const Refit& refit) {
+    const Neighbours known = neighbours(model_neighbours);
+    std::vector<GrainFit> fits(grains_.size());
+#pragma omp parallel
+    {
+      GrainWindow window;
+      std::vector<const HoledSphere*> near;
+#pragma omp for schedule(dynamic, 16)
+      for (std::size_t i = 0; i < grains_.size(); ++i) {
+        if (grains_[i].active && refit(i)) {
+          fits[i] = fit_one(i, model_neighbours, known, window, near);
+        }
+      }
+    }
+    for (std::size_t i = 0; i < grains_.size(); ++i) {
+      if (!grains_[i].active || !refit(i)) continue;
+      Candidate& g = grains_[i];
+      g.fit = fits[i];
+      g.fitted = true;
+      if (shaped_like_a_grain(g.fit)) g.start = g.fit.sphere;
+    }
+  }
+
+  // Keeps the fits that look like grains; of two that found the same grain, the better.
+  void select() {
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < grains_.size(); ++i)
+      if (grains_[i].active) order.push_back(i);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return quality(grains_[a].fit) > quality(grains_[b].fit);
+    });
+    std::vector<Eigen::Vector3d> kept;
+    for (std::size_t i : order) {
+      const GrainFit& f = grains_[i].fit;
+      const bool grain_like = shaped_like_a_grain(f) && f.fluid - f.grain >= o_.min_contrast &&
+                              (f.sphere.centre - grains_[i].found_at).norm() < diameter_;
+      const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const auto& c) {
+        return (c - f.sphere.centre).norm() < 0.5 * diameter_;
+      });
+      grains_[i].active = grain_like && !duplicate;
+      if (grains_[i].active) kept.push_back(f.sphere.centre);
+    }
+  }
+
+  // Refits the axes of every `step`-th grain, the neighbours seen through the model fits'
+  // blur (before the sample) or through `blur` (after it).
+  void refit_axes(const Neighbours& known, std::size_t step, const AxisBlur& blur,
+                  const HoleAxisOptions& axis_options, std::vector<HoleAxisFit>& refits) const {
+    const std::vector<std::size_t>& ids = known.ids;
+#pragma omp parallel
+    {
+      GrainWindow window;
+      std::vector<HoledSphere> near;  // the neighbours as this round sees them
+#pragma omp for schedule(dynamic, 4)
+      for (std::size_t k = 0; k < ids.size(); k += step) {
+        const GrainFit& f = grains_[ids[k]].fit;
+        // Within the refit's radius (the model fit's runs small): ~1 voxel more of the
+        // hole at PSF 1.0 / 1.0 / 1.5 voxel (p95 2.96 -> 2.80 deg at d = 12).
+        const double reach = axis_options.within * (f.sphere.radius + blur.shortfall);
+        const double wide = std::max(blur.across, blur.along_z);
+        near.clear();
+        known.grid.near(f.sphere.centre, 1, [&](std::size_t j) {
+          HoledSphere s = grains_[ids[j]].start;
+          s.radius += blur.shortfall;
+          const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.blur);
+          if (j != k && (s.centre - f.sphere.centre).norm() < reach + reach_j) near.push_back(s);
+        });
+        const auto others = [&](const Eigen::Vector3d& p) {
+          double sum = 0;
+          for (const HoledSphere& s : near) {
+            if (!blur.sampled) {
+              if ((p - s.centre).norm() < s.radius + 4 * s.blur) sum += s.value(p);
+            } else if ((p - s.centre).norm() < s.radius + 5 * wide) {
+              sum += blurred_grain_fraction(p, s, blur.across, blur.along_z);
+            }
+          }
+          return sum;
+        };
+        inner_window(stack_, f.sphere.centre, reach, others, vs_, window);
+        refits[k] = fit_hole_axis(window, f, axis_options);
+      }
+    }
+  }
+
+  // The scan's blur and the radius shortfall, the medians of the sample's converged
+  // refits; every grain's refit starts there (fewer iterations than from the model fit).
+  // False when none converged: the sample's refits stand.
+  bool sample_blur(const std::vector<std::size_t>& ids, const std::vector<HoleAxisFit>& refits,
+                   std::size_t stride, AxisBlur* blur, HoleAxisOptions* axis_options) const {
+    std::vector<double> a, z, r, b, g;
+    for (std::size_t k = 0; k < ids.size(); k += stride) {
+      if (!refits[k].converged) continue;
+      const GrainFit& f = grains_[ids[k]].fit;
+      a.push_back(refits[k].blur_across);
+      z.push_back(refits[k].blur_along_z);
+      r.push_back(refits[k].radius - f.sphere.radius);
+      b.push_back(refits[k].fluid - f.fluid);
+      g.push_back(refits[k].grain - f.grain);
+    }
+    if (a.empty()) return false;
+    const auto median = [](std::vector<double>& v) { return quantile_in_place(v, 0.5); };
+    blur->across = median(a);
+    blur->along_z = median(z);
+    blur->shortfall = median(r);
+    blur->sampled = true;
+    axis_options->start = {blur->across, blur->along_z, blur->shortfall, median(b), median(g)};
+    return true;
+  }
+
+  const Stack& stack_;
+  const LocateOptions& o_;
+  const Eigen::Vector3d vs_;
+  const double diameter_, radius_, hole_;
+  CandidateOptions candidate_options_;
+  std::vector<Candidate> grains_;
+};
+
+// The grain diameter fits in the stack.
+void check_fits(const Stack& stack, const LocateOptions& o) {
+  const Eigen::Vector3d vs = stack.voxel_size.value_or(Eigen::Vector3d::Ones());
+  const Eigen::Vector3d dims(double(stack.nx), double(stack.ny), double(stack.nz));
+  const Eigen::Vector3d diameter = Eigen::Vector3d::Constant(o.diameter * vs.x()).cwiseQuotient(vs);
+  if ((diameter.array() > dims.array()).any()) {
+    const std::string& where = stack.source.empty() ? std::string("stack") : stack.source;
+    throw Error(where + ": grain diameter " + std::to_string(o.diameter) +
+                " voxels is larger than the stack (" + std::to_string(stack.nx) + " x " +
+                std::to_string(stack.ny) + " x " + std::to_string(stack.nz) + ")");
+  }
+}
+
+// The scan's levels made fluid 1, grain 0 (illumination.hpp).
+void normalize(Stack& stack, const LocateOptions& o) {
+  const Eigen::Vector3d vs = stack.voxel_size.value_or(Eigen::Vector3d::Ones());
+  IlluminationOptions light;
+  light.diameter = o.diameter * vs.x() / vs[o.beam_axis];
+  light.dark_grains = o.dark_grains;
+  light.beam_axis = o.beam_axis;
+  if (o.correct_illumination) {
+    normalize_illumination(stack, light);
+  } else {
+    normalize_levels(stack, light);
+  }
+}
+
+}  // namespace
+
+Detections locate(Stack stack, const LocateOptions& o, LocateSummary* summary) {
+  o.validate();
+  check_fits(stack, o);
+  auto clock = std::chrono::steady_clock::now();
+  auto lap = [&clock] {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - clock).count();
+    clock = now;
+    return s;
+  };
+  LocateSummary sum;
+  normalize(stack, o);
+  sum.seconds_illumination = lap();
+  GrainLocator locator(stack, o);
+  locator.find();
+  sum.seconds_candidates = lap();
+  locator.fit();
+  locator.refit_axes();
+  sum.seconds_fits = lap();
+  Detections d = locator.detections(sum);
   sum.seconds = sum.seconds_illumination + sum.seconds_candidates + sum.seconds_fits + lap();
   if (summary) *summary = sum;
   return d;

@@ -22,11 +22,14 @@ struct CandidateOptions {
 // one are dropped. With `found` (grains already located, physical coordinates with
 // `voxel_size`), their model is subtracted first: what is left are the grains they hid.
 // Peaks within half a diameter of a found grain (what its fit leaves, not a grain) are
-// dropped before the separation is applied, so that they hide nothing.
+// dropped before the separation is applied, so that they hide nothing; so are peaks at
+// `tried` (within a quarter diameter; physical): places whose fit found less contrast than
+// a grain's, such as the dark blur of a small pore between grains, stronger than theirs.
 // Returns centres in voxel coordinates, to about a voxel.
 std::vector<Eigen::Vector3d> find_candidates(
     const Stack& normalized, const CandidateOptions& options,
     const std::vector<HoledSphere>* found = nullptr,
-    const Eigen::Vector3d& voxel_size = Eigen::Vector3d::Ones());
+    const Eigen::Vector3d& voxel_size = Eigen::Vector3d::Ones(),
+    const std::vector<Eigen::Vector3d>* tried = nullptr);
 
 }  // namespace granmem

@@ -20,12 +20,18 @@ struct IlluminationOptions {
 
 // Removes what the illumination does to a scan: the fall-off along the laser's path, the
 // slice-to-slice flicker and the streaks along the beam scale the light of the fluid, line
-// by line of each slice. So, slice by slice, voxels are split into fluid and grain halfway
-// between the slice's low and high levels; the fall-off is the fluid's mean intensity
-// along the beam over all lines (smoothed over a diameter); each line's scale is the mean
-// of its own fluid voxels over that profile (hundreds of them: precise), and its grain
-// level the mean of its grain voxels. Each voxel becomes, in place,
-// f = (I - grain level) / (line scale x fall-off - grain level).
+// by line of each slice. Voxels are split into fluid and grain halfway between each slice's
+// fluid level (its own percentile: the light changes from slice to slice) and its grain
+// level (the ratio of the two pooled over two diameters of slices: a slice between layers
+// is nearly all fluid). The levels are read where nothing else leaks in: the fluid's from
+// "deep" fluid, voxels two or more voxels in the slice and a slice away from any grain
+// voxel (pure fluid whatever grains the packing puts near it), the dark level from voxels
+// well inside grains. The fall-off is the deep fluid's mean along the beam (pooled over
+// two diameters of slices and a diameter along the beam); each line's scale is the median
+// of its deep fluid over the fall-off (a line with too few takes its neighbours' or its
+// slice's). Each voxel becomes, in place,
+// f = (I - dark level) / (line scale x fall-off - dark level): 1 in pure fluid, 0 in the
+// grains. Memory: a byte per voxel besides the stack.
 void normalize_illumination(Stack& stack, const IlluminationOptions& options);
 
 // The same with one fluid and one grain level for the whole scan (percentiles of a sample

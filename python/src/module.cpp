@@ -36,7 +36,7 @@
 #include "granmem/rotation/motion_analysis.hpp"
 #include "granmem/sim/simulate.hpp"
 #include "granmem/tracking/detections.hpp"
-#include "granmem/tracking/link.hpp"
+#include "granmem/tracking/link_run.hpp"
 #include "granmem/tracking/locate.hpp"
 #include "granmem/tracking/render.hpp"
 #include "granmem/tracking/stack.hpp"
@@ -379,35 +379,28 @@ py::tuple link_py(const py::list& scans, const std::string& length_unit,
   if (!is_length_unit(length_unit)) {
     throw Error("length_unit '" + length_unit + "': expected m, cm, mm, um or voxel");
   }
-  if (memory < 0) throw Error("memory must be 0 or more");
-  if (container && container_size) {
-    throw Error("container and container_size: give the container or its size, not both");
-  }
+  LinkRunOptions o;
+  o.max_displacement = max_displacement;
+  o.memory = memory;
+  o.collective_motion = drift;
+  o.container = container.value_or("");
+  o.container_size = container_size.value_or("");
+  o.validate();
   std::vector<Detections> found;
+  std::vector<std::string> names;
   for (const py::handle& scan : scans) {
     const auto pair = scan.cast<py::tuple>();
     found.push_back(detections_of(pair[0].cast<py::dict>(), pair[1].cast<std::int64_t>(),
                                   length_unit, voxel_size));
+    names.push_back(found.back().source);
   }
-  if (found.empty()) throw Error("link: no scans");
-  LinkOptions o;
-  if (max_displacement != "auto") {
-    o.max_displacement = parse_length(max_displacement, length_unit, "max_displacement");
-  }
-  o.memory = memory;
-  o.estimate_drift = o.local_field = drift;
-  LinkSummary sum;
-  Trajectories run;
+  LinkRun linked;
   {
     py::gil_scoped_release release;
-    run = link_scans(found, o, &sum);
+    linked = link_run(std::move(found), names, o);
   }
-  if (container) {
-    register_to_container(run, parse_box(*container, "container", length_unit));
-  } else if (container_size) {
-    const Eigen::Vector3d edges = parse_edges(*container_size, length_unit, "container_size");
-    register_to_container(run, container_from_extent(run, edges));
-  }
+  const LinkSummary& sum = linked.summary;
+  const Trajectories& run = linked.run;
   py::list per_scan;
   for (const ScanLinks& r : sum.scans) {
     py::dict d;
@@ -425,6 +418,8 @@ py::tuple link_py(const py::list& scans, const std::string& length_unit,
   summary["tracks"] = sum.tracks;
   summary["max_displacement"] = sum.max_displacement;
   summary["length_unit"] = sum.length_unit;
+  summary["notes"] = linked.notes;
+  summary["report"] = linked.Report();
   summary["scans"] = per_scan;
   const Table t = trajectory_table(run);
   return py::make_tuple(columns_of(t), units_of(t), summary);

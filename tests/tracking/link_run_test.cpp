@@ -1,0 +1,78 @@
+// link_run: `granmem link`'s job on hand-made scans whose every link is known.
+#include "granmem/tracking/link_run.hpp"
+
+#include <gtest/gtest.h>
+
+#include "checks.hpp"
+#include "granmem/core/error.hpp"
+
+namespace granmem {
+namespace {
+
+Detections scan(std::int64_t frame, const std::vector<Eigen::Vector3d>& points,
+                const std::string& unit = "mm") {
+  Detections d;
+  d.frame = frame;
+  d.length_unit = unit;
+  for (const Eigen::Vector3d& p : points)
+    d.add(p, 2.5, 1.0, false);
+  return d;
+}
+
+// The error `f` throws names every one of `parts`.
+template <class F>
+void expect_error(F&& f, const std::vector<std::string>& parts) {
+  const std::string message = testing::error_message(f);
+  for (const std::string& part : parts)
+    EXPECT_NE(message.find(part), std::string::npos) << part << " in: " << message;
+}
+
+// Grain a moves a little, b is not seen again, c appears far from both.
+const Eigen::Vector3d a(10, 10, 10), b(20, 10, 10), c(40, 30, 10);
+std::vector<Detections> scans_of_three_grains() {
+  return {scan(0, {a, b}), scan(0, {a + Eigen::Vector3d(0.2, 0, 0), c})};
+}
+
+TEST(LinkRun, ScansThatAllSayOneFrameAreNumberedInOrder) {
+  const LinkRun r = link_run(scans_of_three_grains(), {"s0", "s1"}, {});
+  ASSERT_EQ(r.run.frames.size(), 2u);
+  EXPECT_EQ(r.run.frames[1].step, 1);
+  ASSERT_EQ(r.notes.size(), 1u);
+  EXPECT_NE(r.notes[0].find("numbered 0..1"), std::string::npos) << r.notes[0];
+  EXPECT_NE(r.Report().find("linked 2 scans: 3 tracks"), std::string::npos) << r.Report();
+}
+
+TEST(LinkRun, WhatCouldNotBeLinkedIsInTheContainersFrame) {
+  LinkRunOptions o;
+  o.container = "1,2,3,51,52,53mm";
+  o.memory = 0;
+  const LinkRun r = link_run(scans_of_three_grains(), {"s0", "s1"}, o);
+  const Eigen::Vector3d origin(1, 2, 3);
+  EXPECT_TRUE(r.run.header.box.has_value());
+  const Table t = unlinked_table(r);
+  ASSERT_EQ(t.rows(), 2u);  // b lost, c new
+  for (std::size_t k = 0; k < 2; ++k) {
+    const bool lost = t["lost"].values[k] == 1;
+    const Eigen::Vector3d at(t["x"].values[k], t["y"].values[k], t["z"].values[k]);
+    // Lost: where the run last saw it; new: where the scan saw it; both from the origin.
+    EXPECT_LT((at - ((lost ? b : c) - origin)).norm(), 1e-12) << k << ": " << at.transpose();
+  }
+  // The run's positions too.
+  EXPECT_LT((r.run.frames[0].position.row(0).transpose() - (a - origin)).norm(), 1e-12);
+}
+
+TEST(LinkRun, BadScansAndOptionsAreOneClearError) {
+  std::vector<Detections> mixed = scans_of_three_grains();
+  mixed[1].length_unit = "cm";
+  expect_error([&] { link_run(mixed, {"s0", "s1"}, {}); }, {"s1", "cm", "one length unit"});
+  LinkRunOptions both;
+  both.container = "0,0,0,5,5,5cm";
+  both.container_size = "5,5,5cm";
+  expect_error([&] { both.validate(); }, {"--container and --container-size"});
+  LinkRunOptions unitless;
+  unitless.container = "0,0,0,5,5,5";
+  expect_error([&] { unitless.validate(); }, {"--container", "length unit"});
+}
+
+}  // namespace
+}  // namespace granmem

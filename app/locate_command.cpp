@@ -1,14 +1,12 @@
 #include <algorithm>
-#include <iomanip>
 #include <iostream>
-#include <sstream>
 
 #include "commands.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
-#include "granmem/tracking/locate.hpp"
+#include "granmem/tracking/locate_scan.hpp"
 #include "granmem/tracking/stack.hpp"
 #include "tracking_steps.hpp"
 
@@ -74,48 +72,28 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args) {
 }
 
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame) {
-  StackReadOptions read;
-  read.dataset = args.dataset;
-  if (!args.region.empty()) read.region = parse_region(args.region);
+  ScanLocateOptions o;
+  o.read.dataset = args.dataset;
+  if (!args.region.empty()) o.read.region = parse_region(args.region);
   if (!args.voxel_size.empty()) {
     const VoxelSize v = parse_voxel_size(args.voxel_size, "--voxel-size");
     if (v.unit.empty() || !is_physical_length_unit(v.unit)) {
       throw Error("--voxel-size '" + args.voxel_size + "': give a unit (m, cm, mm, um)");
     }
-    read.voxel_size = v.size;
-    read.unit = v.unit;
+    o.read.voxel_size = v.size;
+    o.read.unit = v.unit;
   }
-  Stack stack = read_stack(path, read);
-  LocateOptions o;
-  o.diameter = diameter_in_voxels(args.diameter, stack, "--diameter");
-  o.dark_grains = args.polarity == "dark";
-  o.hole_fraction = o.dark_grains ? args.hole_fraction : 0.0;
-  o.beam_axis = args.beam == "y" ? 1 : 0;
-  o.passes = args.passes;
-  o.fit_axis = args.axis == "fit";
-  o.correct_illumination = !args.no_illumination;
-  const std::int64_t voxels = stack.nx * stack.ny * stack.nz;
-
-  LocateSummary sum;
-  Detections d = locate(std::move(stack), o, &sum);  // not needed after
-  d.frame = frame;
-  d.source = path;
-  // Positions in the whole stack's frame, not the region's.
-  if (read.region) {
-    const Eigen::Vector3d origin(double(read.region->x0), double(read.region->y0),
-                                 double(read.region->z0));
-    const Eigen::Vector3d shift =
-        origin.cwiseProduct(d.voxel_size.value_or(Eigen::Vector3d::Ones()));
-    d.position.rowwise() += shift.transpose();
-  }
-  std::cout << path << ": " << sum.located << " grains (" << sum.on_edge
-            << " cut by the stack's edge) from " << sum.candidates << " candidates, " << std::fixed
-            << std::setprecision(1) << sum.seconds << " s (" << std::setprecision(2)
-            << 1e3 * sum.seconds / double(std::max<std::size_t>(1, sum.located))
-            << " ms per grain, " << std::setprecision(1) << 1e-6 * double(voxels) / sum.seconds
-            << " Mvoxel/s)" << std::defaultfloat << "; lengths in " << d.length_unit
-            << (d.voxel_size ? "" : " (no voxel size given or found)") << "\n";
-  return d;
+  o.diameter = args.diameter;
+  o.locate.dark_grains = args.polarity == "dark";
+  o.locate.hole_fraction = o.locate.dark_grains ? args.hole_fraction : 0.0;
+  o.locate.beam_axis = args.beam == "y" ? 1 : 0;
+  o.locate.passes = args.passes;
+  o.locate.fit_axis = args.axis == "fit";
+  o.locate.correct_illumination = !args.no_illumination;
+  o.frame = frame;
+  LocatedScan s = granmem::locate_scan(path, o);
+  std::cout << s.Report();
+  return std::move(s.detections);
 }
 
 void add_locate(CLI::App& app) {

@@ -17,13 +17,15 @@ void add_import(CLI::App& app) {
                             columns;
     double radius = 0;
     std::size_t skip_rows = 0;
+    std::vector<long long> types;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "import",
       "Read a long-form CSV of tracked grains (frame,particle,x,y,z[,ax,ay,az][,radius]"
-      "[,hole_contact]) into a trajectory store");
-  cmd->add_option("table", args->table, "CSV (or tab-separated) table, one row per grain per frame")
+      "[,qw,qx,qy,qz][,hole_contact]) or a LAMMPS text dump into a trajectory store");
+  cmd->add_option("table", args->table,
+                  "CSV (or tab-separated) table, one row per grain per frame, or a LAMMPS dump")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "trajectory store to write (.h5)")->required();
@@ -42,6 +44,9 @@ void add_import(CLI::App& app) {
   cmd->add_option("--columns", args->columns,
                   "the table's names for granmem's columns, NAME=column,... e.g. TrackMate's "
                   "FRAME=frame,TRACK_ID=particle,POSITION_X=x,POSITION_Y=y,POSITION_Z=z");
+  cmd->add_option("--types", args->types,
+                  "LAMMPS dumps: the atom types that are grains, e.g. 1 (default: every atom)")
+      ->delimiter(',');
   cmd->add_option("--skip-rows", args->skip_rows,
                   "lines after the header that are not data (TrackMate's CSV: 3)")
       ->capture_default_str();
@@ -65,17 +70,21 @@ void add_import(CLI::App& app) {
     if (!args->box.empty()) options.box = parse_box(args->box, "--box");
     options.csv.rename = parse_renames(args->columns, "--columns");
     options.csv.skip_rows = args->skip_rows;
+    options.types.insert(args->types.begin(), args->types.end());
 
     ImportSummary summary;
     Trajectories run = import_table(args->table, options, &summary);
     run.header.parameters = used_options(*cmd);
     write_trajectories(args->out, run);
 
-    std::cout << "imported " << summary.rows << " rows of " << args->table << ": " << summary.frames
-              << " frames, " << summary.grains << " grains, " << summary.missing
-              << " missing (grain, frame) entries";
+    std::cout << "imported " << summary.rows << " rows of " << args->table << " (" << summary.format
+              << "): " << summary.frames << " frames, " << summary.grains << " grains, "
+              << summary.missing << " missing (grain, frame) entries";
     if (run.header.has_axis) std::cout << ", cavity axis in " << summary.axes_known << " rows";
-    std::cout << "\nlengths in " << summary.length_unit << "\nwrote " << args->out << " and "
+    std::cout << "\n";
+    for (const std::string& note : summary.notes)
+      std::cout << note << "\n";
+    std::cout << "lengths in " << summary.length_unit << "\nwrote " << args->out << " and "
               << xdmf_path(args->out).string() << "\n";
   });
 }

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <numeric>
 #include <sstream>
 #include <unordered_map>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/lammps_dump.hpp"
 #include "granmem/core/memory_budget.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/units.hpp"
@@ -101,7 +103,25 @@ Scaling scaling_of(const ImportOptions& options) {
 }
 
 const std::vector<std::string> kRequiredColumns{"frame", "particle", "x", "y", "z"};
-const std::vector<std::string> kOptionalColumns{"ax", "ay", "az", "radius", "hole_contact"};
+const std::vector<std::string> kOptionalColumns{"ax", "ay", "az", "radius", "hole_contact",
+                                                "qw", "qx", "qy", "qz"};
+const std::vector<std::string> kOrientation{"qw", "qx", "qy", "qz"};
+
+// A row's orientation (qw, qx, qy, qz; scalar first, as LAMMPS and trajectory_table write
+// it): all empty where it is unknown, else a unit quaternion to the precision a table
+// keeps, stored normalised.
+void read_orientation(const Table& t, std::size_t r, const std::string& where, Frame& frame,
+                      Eigen::Index row) {
+  Eigen::Vector4d q;
+  for (int k = 0; k < 4; ++k)
+    q[k] = t[kOrientation[std::size_t(k)]].values[r];
+  const int unknown = int(q.array().isNaN().count());
+  if (unknown == 4) return;
+  if (unknown > 0 || !q.allFinite() || std::abs(q.norm() - 1) > 1e-3) {
+    throw Error(where + ": orientation (qw,qx,qy,qz) must be a unit quaternion or all empty");
+  }
+  frame.orientation.row(row) = q.normalized().transpose();
+}
 
 Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, const Source& csv,
                          const ImportOptions& options, ImportSummary* summary) {
@@ -116,6 +136,10 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
   const bool has_axis = t.has("ax") || t.has("ay") || t.has("az");
   if (has_axis && !(t.has("ax") && t.has("ay") && t.has("az"))) {
     throw Error(csv.name + ": an axis needs all three columns ax, ay, az");
+  }
+  const bool has_orientation = t.has("qw") || t.has("qx") || t.has("qy") || t.has("qz");
+  if (has_orientation && !(t.has("qw") && t.has("qx") && t.has("qy") && t.has("qz"))) {
+    throw Error(csv.name + ": an orientation needs all four columns qw, qx, qy, qz");
   }
   if (t.has("radius") && options.radius) {
     throw Error(csv.name + ": has a radius column; --radius is for tables without one");
@@ -139,6 +163,12 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
   h.id = particles;
   h.has_axis = has_axis;
   h.has_hole_contact = t.has("hole_contact");
+  h.has_orientation = has_orientation;
+  if (has_orientation && options.voxel_size && (scale.array() != scale.x()).any()) {
+    throw Error(csv.name +
+                ": orientations with voxels of unequal sides would need turning; "
+                "give the table in lengths");
+  }
   if (options.voxel_size) h.voxel_size = *options.voxel_size;
   if (options.box) {
     Box b = *options.box;
@@ -200,6 +230,7 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
         ++axes_known;
       }
     }
+    if (has_orientation) read_orientation(t, r, at(csv, line), frame, row);
     if (h.has_hole_contact) {
       const double flag = t["hole_contact"].values[r];
       if (flag != 0 && flag != 1) {
@@ -239,13 +270,69 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
   return run;
 }
 
+bool is_lammps_dump(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::string_view t = trim(line);
+    if (!t.empty()) return t.rfind("ITEM:", 0) == 0;
+  }
+  return false;
+}
+
+// The dump's options: its unit and its box where the caller gave none.
+ImportOptions dump_options(const LammpsDump& dump, const std::string& where,
+                           const ImportOptions& given, std::vector<std::string>& notes) {
+  ImportOptions o = given;
+  const std::string unit = lammps_length_unit(dump.units);
+  if (!dump.units.empty() && unit.empty()) {
+    throw Error(where + ": LAMMPS units '" + dump.units +
+                "' have no length granmem stores (si, cgs and micro do)");
+  }
+  if (!unit.empty() && given.length_unit != "voxel" && given.length_unit != unit) {
+    throw Error(where + ": the dump's units are " + dump.units + " (" + unit +
+                "), not --length-unit " + given.length_unit);
+  }
+  if (!unit.empty()) {
+    o.length_unit = unit;
+    notes.push_back("lengths in " + unit + ", from the dump's units (" + dump.units + ")");
+  } else if (given.length_unit == "voxel") {
+    throw Error(where +
+                ": a LAMMPS dump without ITEM: UNITS: give its length unit "
+                "(--length-unit; m for units si, cm for cgs)");
+  }
+  if (!o.box && dump.box) {
+    o.box = dump.box;
+    notes.push_back(dump.box_changes ? "box: the first snapshot's bounds (later ones differ)"
+                                     : "box: the dump's bounds");
+  }
+  return o;
+}
+
+Trajectories import_dump(const std::filesystem::path& path, const ImportOptions& options,
+                         ImportSummary* summary) {
+  const LammpsDump dump = read_lammps_dump(path, options.types);
+  std::vector<std::string> notes;
+  const ImportOptions o = dump_options(dump, path.string(), options, notes);
+  Trajectories run = import_rows(dump.table, dump.lines, Source{path.string(), "line"}, o, summary);
+  if (summary) {
+    summary->format = "lammps dump";
+    summary->notes = notes;
+  }
+  return run;
+}
+
 }  // namespace
 
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary) {
+  if (is_lammps_dump(csv)) return import_dump(csv, options, summary);
   scaling_of(options);  // bad options refused before the file is read
   const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns, options.csv);
-  return import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
+  Trajectories run =
+      import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
+  if (summary) summary->format = "csv";
+  return run;
 }
 
 Trajectories import_table(const Table& table, const std::string& source,

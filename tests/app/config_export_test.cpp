@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "granmem/core/hdf5.hpp"
+#include "granmem/core/trajectory_store.hpp"
 #include "run_granmem.hpp"
 
 namespace granmem::testing {
@@ -228,12 +229,15 @@ TEST_F(GranmemTest, ExportLammpsDumpHasTheAtomsOfEachFrame) {
   EXPECT_EQ(bounds, 3u) << boxed;
 }
 
-// LAMMPS itself reads the dump: `read_dump` adds every grain of a frame with its id (the
-// granmem id + 1) and position, and writes them back.
-TEST_F(GranmemTest, ExportLammpsDumpIsReadByLammps) {
-#ifndef GRANMEM_LAMMPS_EXE
-  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
-#else
+// Frame 2 of kExportTable (mm, box 0-10, 0-10, 0-20) exported as a dump, read by LAMMPS
+// (`read_dump`), and written back by it to back.dump with `write_dump ... DUMP_ARGS`.
+class LammpsRoundTrip : public GranmemTest {
+ protected:
+  void frame_2_through_lammps(const std::string& dump_args);
+};
+
+#ifdef GRANMEM_LAMMPS_EXE
+void LammpsRoundTrip::frame_2_through_lammps(const std::string& dump_args) {
   write_text(in_work("t.csv"), kExportTable);
   granmem_ok(
       {"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--box", "0,0,0,10,10,20"});
@@ -242,11 +246,22 @@ TEST_F(GranmemTest, ExportLammpsDumpIsReadByLammps) {
              "units si\natom_style sphere\nboundary f f f\n"
              "region box block 0 1 0 1 0 1\ncreate_box 1 box\n"
              "read_dump run.dump 2 x y z add keep box yes\n"
-             "write_dump all custom back.dump id type x y z modify sort id format float %.17g\n");
+             "write_dump all custom back.dump " +
+                 dump_args + " format float %.17g\n");
   const std::string cmd = "cd " + testing::shell_quote(work().string()) + " && " +
                           testing::shell_quote(GRANMEM_LAMMPS_EXE) +
                           " -in read.lmp -log none -screen none > lmp.out 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << read_text(in_work("lmp.out"));
+}
+#endif
+
+// LAMMPS itself reads the dump: `read_dump` adds every grain of a frame with its id (the
+// granmem id + 1) and position, and writes them back.
+TEST_F(LammpsRoundTrip, ExportLammpsDumpIsReadByLammps) {
+#ifndef GRANMEM_LAMMPS_EXE
+  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
+#else
+  ASSERT_NO_FATAL_FAILURE(frame_2_through_lammps("id type x y z modify sort id"));
   std::istringstream back(read_text(in_work("back.dump")));
   std::string line;
   while (std::getline(back, line) && line.rfind("ITEM: ATOMS", 0) != 0) {
@@ -258,6 +273,28 @@ TEST_F(GranmemTest, ExportLammpsDumpIsReadByLammps) {
   // Frame 2 of the table: grains 10, 20 and 30.
   EXPECT_EQ(atoms, (std::vector<std::vector<double> >{
                        {11, 1, 1.5, 2.5, 3}, {21, 1, 4, 5, 6.5}, {31, 1, 7, 8, 9.5}}));
+#endif
+}
+
+// And back: a dump LAMMPS writes (scaled coordinates, its own column order) is imported
+// as the same grains at the same places, ids and box included: granmem -> LAMMPS -> granmem.
+TEST_F(LammpsRoundTrip, ADumpWrittenByLammpsImportsAsTheSameGrains) {
+#ifndef GRANMEM_LAMMPS_EXE
+  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
+#else
+  ASSERT_NO_FATAL_FAILURE(frame_2_through_lammps("type zs id ys xs modify"));
+  const RunResult r = granmem_ok(
+      {"import", "back.dump", "--out", "back.h5", "--length-unit", "mm", "--types", "1"});
+  EXPECT_NE(r.out.find("(lammps dump): 1 frames, 3 grains, 0 missing"), std::string::npos) << r.out;
+  const TrajectoryReader back(in_work("back.h5"));
+  EXPECT_EQ(back.header().id, (std::vector<std::int64_t>{10, 20, 30}));
+  ASSERT_TRUE(back.header().box);
+  EXPECT_EQ(back.header().box->edges, Eigen::Vector3d(10, 10, 20));
+  ASSERT_EQ(back.frame_count(), 1u);
+  const Frame f = back.read_frame(0);
+  EXPECT_EQ(f.step, 2);
+  const Eigen::Matrix3d expected{{1.5, 2.5, 3}, {4, 5, 6.5}, {7, 8, 9.5}};
+  EXPECT_LT((f.position - expected).cwiseAbs().maxCoeff(), 1e-12) << f.position;
 #endif
 }
 

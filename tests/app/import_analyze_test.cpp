@@ -91,7 +91,7 @@ class ImportAnalyzeTest : public GranmemTest {
                                      "run.h5", "--length-unit", "mm"};
     args.insert(args.end(), extra.begin(), extra.end());
     const RunResult r = granmem_ok(args);
-    EXPECT_NE(r.out.find("imported 11 rows of grains.csv: 3 frames, 4 grains, 1 missing (grain, "
+    EXPECT_NE(r.out.find("imported 11 rows of grains.csv (csv): 3 frames, 4 grains, 1 missing (grain, "
                          "frame) entries, cavity axis in 10 rows"),
               std::string::npos)
         << r.out;

@@ -265,6 +265,22 @@ TEST_F(ImportTable, BadAxesNameTheLine) {
   expect_nan_row(run.frames[2].axis, 0);
 }
 
+// Orientations as trajectory_table writes them (qw, qx, qy, qz): a unit quaternion per
+// row, stored normalised; all four empty where unknown; anything else names the line.
+TEST_F(ImportTable, OrientationsAreUnitQuaternions) {
+  const std::string head = "frame,particle,x,y,z,qw,qx,qy,qz\n0,1,1,1,1,0,0.6,0,0.8\n";
+  const auto file = path("ok.csv");
+  write_text(file, head + "1,1,1,1,1,,,,\n");
+  const Trajectories run = import_table(file, {});
+  ASSERT_TRUE(run.header.has_orientation);
+  EXPECT_EQ(run.frames[0].orientation.row(0), Eigen::RowVector4d(0, 0.6, 0, 0.8));
+  EXPECT_TRUE(run.frames[1].orientation.row(0).array().isNaN().all());
+  expect_error(head + "1,1,1,1,1,1,0,0,0.1\n", "line 3: orientation (qw,qx,qy,qz) must be a unit");
+  expect_error(head + "1,1,1,1,1,1,,0,0\n", "line 3: orientation");
+  expect_error("frame,particle,x,y,z,qw,qx,qy\n0,1,1,1,1,1,0,0\n",
+               "all four columns qw, qx, qy, qz");
+}
+
 TEST_F(ImportTable, BadLabelsNameTheLine) {
   expect_error("frame,particle,x,y,z\n0,1,1,1,1\n1.5,1,1,1,1\n", "line 3, column 'frame'");
   expect_error("frame,particle,x,y,z\n,1,1,1,1\n", "line 2, column 'frame'");

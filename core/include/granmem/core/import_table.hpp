@@ -4,7 +4,9 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectories.hpp"
@@ -28,20 +30,30 @@ struct ImportOptions {
   std::string sample = kSampleEndOfCycle;
   // Other programs' column names and header rows (TrackMate, MATLAB; files only).
   CsvReadOptions csv;
+  // LAMMPS dumps: the atom types that are grains (not a lid or wall particles); empty
+  // keeps every atom.
+  std::set<long long> types;
 };
 
 struct ImportSummary {
   std::size_t rows = 0;
   std::size_t frames = 0;
   std::size_t grains = 0;
-  std::size_t missing = 0;     // (frame, grain) pairs with no row
-  std::size_t axes_known = 0;  // rows with a cavity axis
-  std::string length_unit;     // unit of the stored positions
+  std::size_t missing = 0;         // (frame, grain) pairs with no row
+  std::size_t axes_known = 0;      // rows with a cavity axis
+  std::string length_unit;         // unit of the stored positions
+  std::string format;              // "csv" or "lammps dump"
+  std::vector<std::string> notes;  // what was taken from the file, for the user
 };
 
 // Reads the table into a run: frames in increasing `frame` order (step = frame label),
 // grains in increasing `particle` order (id = particle label). A grain missing from a
-// frame gets NaN. Throws Error naming file, line and column for bad rows.
+// frame gets NaN. Throws Error naming file, line and column for bad rows. A file that
+// starts with "ITEM:" is read as a LAMMPS text dump (core/lammps_dump.hpp): snapshots
+// become frames (step = TIMESTEP), atoms grains (id = atom id); its length unit is the
+// dump's `ITEM: UNITS` where it has one (it must then agree with a --length-unit other
+// than voxel) and must be given where it has none; its box is the first snapshot's
+// bounds unless `box` is given.
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary = nullptr);
 // The same from a table in memory (a pandas DataFrame's columns); `source` names it in

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages granmem needs, skipping those already there.
+# Installs the Debian 12 packages granmem needs, skipping those already there, and any
+# packages named as arguments (scripts/sanitize.sh: clang and its sanitizer runtimes).
 # Runs as root, or through sudo when there is one.
 set -euo pipefail
 
@@ -11,6 +12,8 @@ packages=(
   libopenmpi-dev openmpi-bin
   lammps
   python3-dev pybind11-dev python3-numpy python3-pandas python3-pytest python3-matplotlib
+  python3-h5py
+  "$@"
 )
 
 missing=()

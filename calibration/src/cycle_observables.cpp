@@ -185,7 +185,7 @@ std::string steady_state_label(const std::string& name) {
 
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
                          const StructureOptions& structure) {
-  const auto [first, last] = observed.window;
+  const std::int64_t first = observed.window.first, last = observed.window.second;
   auto in_window = [&](std::int64_t c) { return c >= first && c <= last; };
   SteadyState s;
   // The window's mean, and its least-squares change across the window (slope x cycles).

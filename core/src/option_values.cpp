@@ -55,7 +55,10 @@ std::pair<std::int64_t, std::int64_t> parse_int_range(const std::string& text,
                                                       const std::string& option) {
   const auto [a, b] = split_colon(text, option);
   const double lo = plain_number(a, option), hi = plain_number(b, option);
-  if (lo != std::floor(lo) || hi != std::floor(hi)) {
+  // Frame labels are 64-bit integers; beyond 2^53 a double no longer holds every one.
+  constexpr double kLargest = 9007199254740992.0;
+  if (lo != std::floor(lo) || hi != std::floor(hi) || !(std::abs(lo) <= kLargest) ||
+      !(std::abs(hi) <= kLargest)) {
     throw Error(option + " '" + text + "': expected whole frame numbers");
   }
   return {static_cast<std::int64_t>(lo), static_cast<std::int64_t>(hi)};

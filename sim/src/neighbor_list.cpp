@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 #include <numeric>
+#include <string>
+
+#include "granmem/core/error.hpp"
 
 namespace granmem {
 
@@ -21,6 +24,11 @@ void NeighborList::build(const Grains& g) {
   Eigen::Vector3d lo = g.x[0], hi = g.x[0];
   double r_max = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    // A grain thrown out of the packing (a step too long for its contacts) has no cell.
+    if (!g.x[i].allFinite()) {
+      throw Error("neighbour list: grain " + std::to_string(g.id[i]) +
+                  " has no finite position (a time step too long for the contacts?)");
+    }
     lo = lo.cwiseMin(g.x[i]);
     hi = hi.cwiseMax(g.x[i]);
     r_max = std::max(r_max, g.radius[i]);

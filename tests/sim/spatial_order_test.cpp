@@ -112,12 +112,13 @@ TEST(SpatialOrder, TheContinuationIsTheSamePhysics) {
   EXPECT_EQ(a.contact_count(), b.contact_count());
 }
 
+// A grain without a finite position (a blown-up step, a damaged checkpoint) has no place
+// in the neighbour list's cells, nor in a spatial order: the simulation is refused.
 TEST(SpatialOrder, AGrainWithoutAFinitePositionIsRefused) {
   Grains g = testing::lattice_cluster(2, 2, 2, 1.2, 1);
   g.x[3].y() = std::nan("");
-  const Simulation sim(g, testing::wide_box(1.0), PhysicsOptions{});
   try {
-    in_spatial_order(sim);
+    const Simulation sim(g, testing::wide_box(1.0), PhysicsOptions{});
     FAIL() << "accepted a NaN position";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("grain 33 has no finite position"), std::string::npos)

@@ -45,7 +45,12 @@ struct PhysicsOptions {
 
 // Forces the grains exert on the walls at the last step.
 struct WallLoads {
-  std::array<Eigen::Vector3d, kWallCount> force{};
+  // Zeros, set explicitly: `{}` leaves Eigen's vectors uninitialised.
+  std::array<Eigen::Vector3d, kWallCount> force = [] {
+    std::array<Eigen::Vector3d, kWallCount> f;
+    f.fill(Eigen::Vector3d::Zero());
+    return f;
+  }();
   std::array<int, kWallCount> contacts{};
 };
 

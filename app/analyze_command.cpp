@@ -68,7 +68,7 @@ void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& opti
 
 void add_analyze(CLI::App& app) {
   struct Args {
-    std::string run, out, wall_distance = "0", box, hole_contacts = "keep", pdf, pdf_frames,
+    std::string run, out, wall_distance = "0", container, hole_contacts = "keep", pdf, window,
                           pdf_scale = "linear", pdf_range;
     bool subtract_drift = false;
     std::size_t pdf_bins = 50;
@@ -78,13 +78,12 @@ void add_analyze(CLI::App& app) {
       "analyze", "Displacements and rotations between consecutive frames, per-frame means, pdfs");
   cmd->add_option("run", args->run, "trajectory store (.h5)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "output folder")->required();
-  cmd->add_flag("--subtract-drift", args->subtract_drift,
-                "remove the mean displacement of the analysed grains, frame by frame");
+  add_drift_flags(cmd, args->subtract_drift);
   cmd->add_option("--wall-distance", args->wall_distance,
                   "leave out grains whose centre is closer than this to a container face "
                   "(run's length unit, or give one: 0.5cm)")
       ->capture_default_str();
-  cmd->add_option("--box", args->box,
+  cmd->add_option("--container", args->container,
                   "container xmin,ymin,zmin,xmax,ymax,zmax (run's unit); default the run's box");
   cmd->add_option("--hole-contacts", args->hole_contacts,
                   "grains touching through their hole: keep, exclude-rotations, exclude")
@@ -93,8 +92,8 @@ void add_analyze(CLI::App& app) {
   cmd->add_option("--pdf", args->pdf,
                   "quantities for pdfs, comma list (dr,dx,dy,dz,theta_axis_deg,rot_disp,"
                   "theta_full_deg); default all the run has");
-  cmd->add_option("--pdf-frames", args->pdf_frames,
-                  "FIRST:LAST frames (labels) pooled into the pdfs; default all");
+  cmd->add_option("--window", args->window,
+                  "FIRST:LAST frames (labels: cycles or scans) pooled into the pdfs; default all");
   cmd->add_option("--pdf-bins", args->pdf_bins, "number of bins")
       ->check(CLI::Validator(
           [](std::string& text) {
@@ -119,12 +118,10 @@ void add_analyze(CLI::App& app) {
     options.motion.subtract_drift = args->subtract_drift;
     options.motion.wall_distance =
         parse_length(args->wall_distance, h.length_unit, "--wall-distance");
-    if (!args->box.empty()) options.motion.box = parse_box(args->box, "--box");
+    if (!args->container.empty()) options.motion.box = parse_box(args->container, "--container");
     options.motion.hole_contacts = hole_contact_policy(args->hole_contacts, "--hole-contacts");
     options.pdf_quantities = split_list(args->pdf);
-    if (!args->pdf_frames.empty()) {
-      options.pdf_frames = parse_int_range(args->pdf_frames, "--pdf-frames");
-    }
+    if (!args->window.empty()) options.pdf_frames = parse_int_range(args->window, "--window");
     options.density.bins = args->pdf_bins;
     options.density.scale = args->pdf_scale == "log" ? BinScale::logarithmic : BinScale::linear;
     if (!args->pdf_range.empty())

@@ -28,7 +28,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                  wall_distance = "0", preparation = "each", summaries = "pooled",
                                  observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
-    bool keep_drift = false, fit_only = false;
+    bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 2;
   };
   auto args = std::make_shared<Args>();
@@ -52,8 +52,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--wall-distance", args->wall_distance,
                   "leave out grains closer than this to a container face (with a unit)")
       ->capture_default_str();
-  cmd->add_flag("--keep-drift", args->keep_drift,
-                "keep the packing's mean displacement (default: subtracted, both sides)");
+  add_drift_flags(cmd, args->subtract_drift);
   cmd->add_option("--degree", args->degree,
                   "degree of the polynomial in log mu_s through the runs' summaries")
       ->capture_default_str();
@@ -129,7 +128,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.noise = args->noise;
     o.per_cycle = args->summaries == "per-cycle";
     o.wall_distance = parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
-    o.subtract_drift = !args->keep_drift;
+    o.subtract_drift = args->subtract_drift;
     o.degree = args->degree;
     o.replicas = args->replicas;
     o.preparation = args->preparation == "shared" ? TwinPreparation::shared : TwinPreparation::each;

@@ -31,6 +31,11 @@ void add_link(CLI::App& app);
 void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& options,
                         const std::string& out, const std::map<std::string, std::string>& used);
 
+// The packing's drift (its mean displacement, frame by frame), one pair of flags in every
+// command that has it: --subtract-drift removes it, --keep-drift keeps it; `subtract`
+// holds the command's default when called.
+void add_drift_flags(CLI::App* command, bool& subtract);
+
 // The options of a subcommand as actually used (given or default), "<command>/<option>"
 // -> value, for the output's /parameters.
 std::map<std::string, std::string> used_options(const CLI::App& command);

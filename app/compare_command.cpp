@@ -11,7 +11,7 @@ namespace granmem::app {
 void add_compare(CLI::App& app) {
   struct Args {
     std::string a, b, out, window, diameter, label_a = "A", label_b = "B", wall_distance = "0";
-    bool keep_drift = false;
+    bool subtract_drift = true;
     std::size_t steady_points = 0;
   };
   auto args = std::make_shared<Args>();
@@ -39,8 +39,7 @@ void add_compare(CLI::App& app) {
   cmd->add_option("--wall-distance", args->wall_distance,
                   "leave out grains closer than this to a container face (with a unit)")
       ->capture_default_str();
-  cmd->add_flag("--keep-drift", args->keep_drift,
-                "keep the packing's mean displacement (default: subtracted)");
+  add_drift_flags(cmd, args->subtract_drift);
   cmd->add_option("--steady-points", args->steady_points,
                   "relaxation (Fig. 3): hold the steady state at the mean of the last N cycles, "
                   "the paper's way (20 of its 500), instead of fitting it (0)")
@@ -55,7 +54,7 @@ void add_compare(CLI::App& app) {
       o.diameter = parse_si(args->diameter, Dimension::length, "", "--diameter");
     }
     o.wall_distance = parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
-    o.subtract_drift = !args->keep_drift;
+    o.subtract_drift = args->subtract_drift;
     o.steady_points = args->steady_points;
     o.dir = args->out;
     const Comparison c = compare(a, b, o);

@@ -13,8 +13,8 @@ namespace granmem::app {
 
 void add_import(CLI::App& app) {
   struct Args {
-    std::string table, out, length_unit = "voxel", voxel_size, box, sample = kSampleEndOfCycle,
-                            columns;
+    std::string table, out, length_unit = "voxel", voxel_size, container,
+                            sample = kSampleEndOfCycle, columns;
     double radius = 0;
     std::size_t skip_rows = 0;
     std::vector<long long> types;
@@ -36,7 +36,7 @@ void add_import(CLI::App& app) {
                   "voxel size X[,Y,Z] with a unit, e.g. 0.05,0.05,0.075mm (voxel tables)");
   CLI::Option* radius =
       cmd->add_option("--radius", args->radius, "grain radius for tables without a radius column");
-  cmd->add_option("--box", args->box,
+  cmd->add_option("--container", args->container,
                   "container xmin,ymin,zmin,xmax,ymax,zmax in the table's unit");
   cmd->add_option("--sample", args->sample, "what a frame is")
       ->check(CLI::IsMember({kSampleEndOfCycle, kSampleFullCompression, kSampleInCycle}))
@@ -67,7 +67,7 @@ void add_import(CLI::App& app) {
                                          : Eigen::Vector3d(v[0].value, v[1].value, v[2].value);
       options.voxel_size_unit = v[0].unit;
     }
-    if (!args->box.empty()) options.box = parse_box(args->box, "--box");
+    if (!args->container.empty()) options.box = parse_box(args->container, "--container");
     options.csv.rename = parse_renames(args->columns, "--columns");
     options.csv.skip_rows = args->skip_rows;
     options.types.insert(args->types.begin(), args->types.end());

@@ -36,7 +36,7 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
   cmd->add_option("--memory", args.memory, "scans a grain may go unseen and still rejoin its track")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_flag("--no-drift", args.no_drift,
+  cmd->add_flag("--no-collective-motion", args.no_drift,
                 "do not estimate the collective motion (drift, uniform deformation, local "
                 "displacement field) between scans");
   cmd->add_option("--container", args.container,

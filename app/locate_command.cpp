@@ -55,8 +55,10 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args) {
                   "hole diameter over grain diameter (dark grains); 0: no hole")
       ->check(CLI::Range(0.0, 0.8))
       ->capture_default_str();
-  cmd->add_option("--beam", args.beam, "the laser sheet's path across the slices: x or y")
-      ->check(CLI::IsMember({"x", "y"}))
+  cmd->add_option("--beam", args.beam,
+                  "the laser sheet's path across the slices: x or y (or the side it enters, as "
+                  "render takes it: +x, -x, +y, -y)")
+      ->check(CLI::IsMember({"x", "y", "+x", "-x", "+y", "-y"}))
       ->capture_default_str();
   cmd->add_option("--axis", args.axis,
                   "the hole's axis: fitted with the grain model, or the lab's classical "
@@ -86,7 +88,7 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
   o.diameter = args.diameter;
   o.locate.dark_grains = args.polarity == "dark";
   o.locate.hole_fraction = o.locate.dark_grains ? args.hole_fraction : 0.0;
-  o.locate.beam_axis = args.beam == "y" ? 1 : 0;
+  o.locate.beam_axis = args.beam.back() == 'y' ? 1 : 0;
   o.locate.passes = args.passes;
   o.locate.fit_axis = args.axis == "fit";
   o.locate.correct_illumination = !args.no_illumination;

@@ -30,6 +30,20 @@ std::string config_error(const std::string& what) {
   return "--config: no option " + line + " ([command] option)";
 }
 
+// Options whose value is a comma list take a TOML array too: `mu-s = [0.05, 0.2]` in the
+// config is `--mu-s 0.05,0.2` (CLI11 splits both at commas and joins the items again).
+void accept_toml_arrays(CLI::App& app) {
+  for (const char* name :
+       {"--mu-s", "--mu-r", "--amplitudes", "--pdf", "--only", "--voxel-size", "--container",
+        "--container-size", "--region", "--columns", "--noise", "--streaks"}) {
+    for (CLI::App* command : app.get_subcommands({})) {
+      if (CLI::Option* o = command->get_option_no_throw(name)) {
+        o->delimiter(',')->multi_option_policy(CLI::MultiOptionPolicy::Join);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,6 +69,7 @@ int main(int argc, char** argv) {
   granmem::app::add_track(app);
   granmem::app::add_render(app);
   granmem::app::add_link(app);
+  accept_toml_arrays(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

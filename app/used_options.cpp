@@ -20,4 +20,11 @@ std::map<std::string, std::string> used_options(const CLI::App& command) {
   return used;
 }
 
+void add_drift_flags(CLI::App* command, bool& subtract) {
+  command->add_flag("--subtract-drift,!--keep-drift", subtract,
+                    std::string("remove the packing's mean displacement, frame by frame, or keep "
+                                "it (default: ") +
+                        (subtract ? "subtracted" : "kept") + ")");
+}
+
 }  // namespace granmem::app

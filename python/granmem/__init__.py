@@ -197,18 +197,18 @@ def _range(value):
     return f"{lo}:{hi}"
 
 
-def analyze(run, subtract_drift=False, wall_distance=0, box=None, hole_contacts="keep",
-            pdf=(), pdf_frames=None, pdf_bins=50, pdf_scale="linear", pdf_range=None):
+def analyze(run, subtract_drift=False, wall_distance=0, container=None, hole_contacts="keep",
+            pdf=(), window=None, pdf_bins=50, pdf_scale="linear", pdf_range=None):
     """The paper's statistics of a run between consecutive frames, as ``granmem analyze``
     (the same tables as its CSV files), for a trajectory store's path.
 
     Returns a dict: ``displacements`` (a row per grain per frame pair), ``per_frame``
     (means, medians, MSD, drift, packing fraction, coordination), ``pdfs`` (quantity ->
     DataFrame of bins) as DataFrames, and ``notes`` (what was left out and why).
-    ``pdf_frames`` and ``pdf_range`` as ``(lo, hi)`` or "lo:hi"; ``box`` as
-    "xmin,ymin,zmin,xmax,ymax,zmax"."""
-    out = _granmem.analyze(os.fspath(run), bool(subtract_drift), _length(wall_distance), box,
-                           hole_contacts, list(pdf), _range(pdf_frames), int(pdf_bins),
+    ``window`` (the frames pooled into the pdfs) and ``pdf_range`` as ``(lo, hi)`` or
+    "lo:hi"; ``container`` as "xmin,ymin,zmin,xmax,ymax,zmax"."""
+    out = _granmem.analyze(os.fspath(run), bool(subtract_drift), _length(wall_distance), container,
+                           hole_contacts, list(pdf), _range(window), int(pdf_bins),
                            pdf_scale, _range(pdf_range))
     unit = out["length_unit"]
     tables = {name: _frame(*out[name], length_unit=unit) for name in ("displacements",

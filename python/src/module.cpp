@@ -189,13 +189,16 @@ LocateOptions locate_options(const Stack& stack, const std::string& diameter,
   if (polarity != "dark" && polarity != "bright") {
     throw Error("polarity '" + polarity + "': expected 'dark' or 'bright'");
   }
-  if (beam != "x" && beam != "y") throw Error("beam '" + beam + "': expected 'x' or 'y'");
+  const std::vector<std::string> beams{"x", "y", "+x", "-x", "+y", "-y"};
+  if (std::find(beams.begin(), beams.end(), beam) == beams.end()) {
+    throw Error("beam '" + beam + "': expected x or y (or the side it enters: +x, -x, +y, -y)");
+  }
   if (axis != "fit" && axis != "lab") throw Error("axis '" + axis + "': expected 'fit' or 'lab'");
   LocateOptions o;
   o.diameter = diameter_in_voxels(diameter, stack, "diameter");
   o.dark_grains = polarity == "dark";
   o.hole_fraction = o.dark_grains ? hole_fraction : 0.0;
-  o.beam_axis = beam == "y" ? 1 : 0;
+  o.beam_axis = beam.back() == 'y' ? 1 : 0;
   o.fit_axis = axis == "fit";
   o.passes = passes;
   o.correct_illumination = illumination;
@@ -471,9 +474,9 @@ py::dict motion_of(const Trajectories& run, std::int64_t before, std::int64_t af
 // ------------------------------------------------------------------------------ analyze
 
 py::dict analyze_py(const std::filesystem::path& path, bool subtract_drift,
-                    const std::string& wall_distance, const std::optional<std::string>& box,
+                    const std::string& wall_distance, const std::optional<std::string>& container,
                     const std::string& hole_contacts, const std::vector<std::string>& pdf,
-                    const std::optional<std::string>& pdf_frames, std::size_t pdf_bins,
+                    const std::optional<std::string>& window, std::size_t pdf_bins,
                     const std::string& pdf_scale, const std::optional<std::string>& pdf_range) {
   if (pdf_scale != "linear" && pdf_scale != "log") {
     throw Error("pdf_scale '" + pdf_scale + "': expected linear or log");
@@ -482,10 +485,10 @@ py::dict analyze_py(const std::filesystem::path& path, bool subtract_drift,
   AnalysisOptions o;
   o.motion.subtract_drift = subtract_drift;
   o.motion.wall_distance = parse_length(wall_distance, run.header().length_unit, "wall_distance");
-  if (box) o.motion.box = parse_box(*box, "box");
+  if (container) o.motion.box = parse_box(*container, "container");
   o.motion.hole_contacts = hole_contact_policy(hole_contacts, "hole_contacts");
   o.pdf_quantities = pdf;
-  if (pdf_frames) o.pdf_frames = parse_int_range(*pdf_frames, "pdf_frames");
+  if (window) o.pdf_frames = parse_int_range(*window, "window");
   o.density.bins = pdf_bins;
   o.density.scale = pdf_scale == "log" ? BinScale::logarithmic : BinScale::linear;
   if (pdf_range) o.density.range = parse_range(*pdf_range, "pdf_range");
@@ -884,10 +887,10 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("training_amplitude") = true, py::arg("parallel") = 0,
         py::arg("bootstrap") = ReadoutOptions{}.bootstrap, py::arg("progress") = py::none());
   m.def("analyze", &analyze_py, py::arg("path"), py::arg("subtract_drift") = false,
-        py::arg("wall_distance") = "0", py::arg("box") = py::none(),
+        py::arg("wall_distance") = "0", py::arg("container") = py::none(),
         py::arg("hole_contacts") = "keep", py::arg("pdf") = std::vector<std::string>{},
-        py::arg("pdf_frames") = py::none(), py::arg("pdf_bins") = 50,
-        py::arg("pdf_scale") = "linear", py::arg("pdf_range") = py::none());
+        py::arg("window") = py::none(), py::arg("pdf_bins") = 50, py::arg("pdf_scale") = "linear",
+        py::arg("pdf_range") = py::none());
   m.def(
       "motion_of_run",
       [](const std::filesystem::path& path, std::int64_t before, std::int64_t after,

@@ -110,9 +110,9 @@ def test_analyze_in_python_equals_the_command_line(tmp_path, cli):
     cli("import", sample, "--out", "run.h5", "--length-unit", "voxel",
         "--voxel-size", "0.41667,0.41667,0.625mm")
     cli("analyze", "run.h5", "--out", "a", "--subtract-drift", "--hole-contacts",
-        "exclude-rotations", "--pdf-frames", "6:15", "--pdf-scale", "log")
+        "exclude-rotations", "--window", "6:15", "--pdf-scale", "log")
     a = granmem.analyze(tmp_path / "run.h5", subtract_drift=True,
-                        hole_contacts="exclude-rotations", pdf_frames=(6, 15), pdf_scale="log")
+                        hole_contacts="exclude-rotations", window=(6, 15), pdf_scale="log")
     assert a["per_frame"].attrs["length_unit"] == "mm"
     for name in ["displacements", "per_frame", "pdf_dr", "pdf_theta_axis_deg"]:
         from_cli = pd.read_csv(tmp_path / "a" / f"{name}.csv", comment="#")

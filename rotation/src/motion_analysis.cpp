@@ -129,7 +129,7 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
   a.pdf_frames = options.pdf_frames.value_or(std::make_pair(steps[1], steps.back()));
   const auto [first, last] = a.pdf_frames;
   if (first > last)
-    throw Error("--pdf-frames: first frame " + std::to_string(first) + " is after last frame " +
+    throw Error("--window: first frame " + std::to_string(first) + " is after last frame " +
                 std::to_string(last));
   std::vector<std::string> quantities = options.pdf_quantities;
   if (quantities.empty()) {
@@ -148,7 +148,7 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
     return a;
   }
   if (window.empty()) {
-    throw Error("--pdf-frames " + std::to_string(first) + ":" + std::to_string(last) +
+    throw Error("--window " + std::to_string(first) + ":" + std::to_string(last) +
                 ": no displacements in these frames (the run's frames are " +
                 std::to_string(steps.front()) + " to " + std::to_string(steps.back()) +
                 ", displacements start at frame " + std::to_string(steps[1]) + ")");

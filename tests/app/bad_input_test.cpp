@@ -147,8 +147,8 @@ TEST_F(BadInputTest, ImportBadOptions) {
       {"--voxel-size applies to voxel coordinates, but --length-unit is mm"});
   expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--length-unit", "inch"},
                        {"--length-unit", "inch"});
-  expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--box", "0,0,0,1,1"},
-                       {"--box", "expected six numbers"});
+  expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--container", "0,0,0,1,1"},
+                       {"--container", "expected six numbers"});
   expect_clean_failure({"import", "good.csv", "--out", "run.h5", "--radius", "2"},
                        {"good.csv: has a radius column; --radius is for tables without one"});
   expect_clean_failure({"import", "nothere.csv", "--out", "run.h5"}, {"nothere.csv"});
@@ -417,10 +417,10 @@ TEST_F(BadInputTest, AnalyzeBadOptions) {
     args.insert(args.end(), extra.begin(), extra.end());
     return args;
   };
-  expect_clean_failure(analyze({"--pdf-frames", "7:9"}),
-                       {"--pdf-frames 7:9: no displacements in these frames"});
-  expect_clean_failure(analyze({"--pdf-frames", "2:1"}), {"--pdf-frames", "after last frame"});
-  expect_clean_failure(analyze({"--pdf-frames", "1-2"}), {"--pdf-frames '1-2'", "FIRST:LAST"});
+  expect_clean_failure(analyze({"--window", "7:9"}),
+                       {"--window 7:9: no displacements in these frames"});
+  expect_clean_failure(analyze({"--window", "2:1"}), {"--window", "after last frame"});
+  expect_clean_failure(analyze({"--window", "1-2"}), {"--window '1-2'", "FIRST:LAST"});
   expect_clean_failure(analyze({"--pdf", "speed"}), {"pdf of 'speed': not a quantity of this run"});
   expect_clean_failure(analyze({"--pdf-range", "5:1"}), {"pdf: empty value range"});
   expect_clean_failure(analyze({"--pdf-scale", "log", "--pdf-range", "0:1"}),
@@ -434,10 +434,10 @@ TEST_F(BadInputTest, AnalyzeBadOptions) {
                        {"excluding grains near the walls needs the container"});
   expect_clean_failure(analyze({"--wall-distance", "-1"}),
                        {"--wall-distance '-1': expected a non-negative length"});
-  expect_clean_failure(analyze({"--wall-distance", "1 voxel", "--box", "0,0,0,9,9,9"}),
+  expect_clean_failure(analyze({"--wall-distance", "1 voxel", "--container", "0,0,0,9,9,9"}),
                        {"--wall-distance '1 voxel': cannot convert voxel to the run's unit mm"});
-  expect_clean_failure(analyze({"--box", "0,0,0,-1,9,9"}),
-                       {"--box", "each max must be greater than its min"});
+  expect_clean_failure(analyze({"--container", "0,0,0,-1,9,9"}),
+                       {"--container", "each max must be greater than its min"});
   // The output folder is a file, or one of its outputs is a folder.
   expect_clean_failure({"analyze", "run.h5", "--out", "x.dump"},
                        {"x.dump: cannot create the output folder"});

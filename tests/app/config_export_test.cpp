@@ -32,7 +32,7 @@ const char* kConfig =
     "[import]\n"
     "length-unit = \"voxel\"\n"
     "voxel-size = \"0.5,0.5,2mm\"\n"
-    "box = \"0,0,0,20,20,20\"\n"
+    "container = \"0,0,0,20,20,20\"\n"
     "\n"
     "[analyze]\n"
     "subtract-drift = true\n"
@@ -48,6 +48,22 @@ class ConfigTest : public GranmemTest {
     write_text(in_work("granmem.toml"), kConfig);
   }
 };
+
+// A comma list may be a TOML array: the same options as kConfig's strings.
+TEST_F(ConfigTest, ListsMayBeTomlArrays) {
+  write_text(in_work("arrays.toml"),
+             "[import]\nlength-unit = \"voxel\"\nvoxel-size = [0.5, 0.5, \"2mm\"]\n"
+             "container = [0, 0, 0, 20, 20, 20]\n[analyze]\npdf = [\"dr\", \"dz\"]\n");
+  granmem_ok({"--config", "arrays.toml", "import", "voxels.csv", "--out", "run.h5"});
+  const RunResult info = granmem_ok({"info", "run.h5"});
+  EXPECT_TRUE(contains(info.out, "  lengths     mm, voxel size (0.5, 0.5, 2) mm\n")) << info.out;
+  EXPECT_TRUE(contains(info.out, "  box         lower (0, 0, 0), edges (10, 10, 40) mm\n"))
+      << info.out;
+  granmem_ok({"--config", "arrays.toml", "analyze", "run.h5", "--out", "a"});
+  EXPECT_TRUE(fs::exists(in_work("a") / "pdf_dr.csv"));
+  EXPECT_TRUE(fs::exists(in_work("a") / "pdf_dz.csv"));
+  EXPECT_FALSE(fs::exists(in_work("a") / "pdf_dx.csv"));
+}
 
 TEST_F(ConfigTest, ImportSectionSetsTheOptions) {
   granmem_ok({"--config", "granmem.toml", "import", "voxels.csv", "--out", "run.h5"});
@@ -217,8 +233,8 @@ TEST_F(GranmemTest, ExportLammpsDumpHasTheAtomsOfEachFrame) {
                 "31 1 7 8 9.5 nan 0 -1 0 1\n");
 
   // With a container, every frame has its bounds; --format overrides the file name.
-  granmem_ok(
-      {"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--box", "0,0,0,10,10,20"});
+  granmem_ok({"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--container",
+              "0,0,0,10,10,20"});
   granmem_ok({"export", "boxed.h5", "--out", "boxed.txt", "--format", "lammps"});
   const std::string boxed = read_text(in_work("boxed.txt"));
   std::size_t bounds = 0;
@@ -239,8 +255,8 @@ class LammpsRoundTrip : public GranmemTest {
 #ifdef GRANMEM_LAMMPS_EXE
 void LammpsRoundTrip::frame_2_through_lammps(const std::string& dump_args) {
   write_text(in_work("t.csv"), kExportTable);
-  granmem_ok(
-      {"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--box", "0,0,0,10,10,20"});
+  granmem_ok({"import", "t.csv", "--out", "boxed.h5", "--length-unit", "mm", "--container",
+              "0,0,0,10,10,20"});
   granmem_ok({"export", "boxed.h5", "--out", "run.dump"});
   write_text(in_work("read.lmp"),
              "units si\natom_style sphere\nboundary f f f\n"

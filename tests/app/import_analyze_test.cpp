@@ -91,9 +91,10 @@ class ImportAnalyzeTest : public GranmemTest {
                                      "run.h5", "--length-unit", "mm"};
     args.insert(args.end(), extra.begin(), extra.end());
     const RunResult r = granmem_ok(args);
-    EXPECT_NE(r.out.find("imported 11 rows of grains.csv (csv): 3 frames, 4 grains, 1 missing (grain, "
-                         "frame) entries, cavity axis in 10 rows"),
-              std::string::npos)
+    EXPECT_NE(
+        r.out.find("imported 11 rows of grains.csv (csv): 3 frames, 4 grains, 1 missing (grain, "
+                   "frame) entries, cavity axis in 10 rows"),
+        std::string::npos)
         << r.out;
     EXPECT_EQ(r.err, "");
   }
@@ -214,7 +215,7 @@ TEST_F(ImportAnalyzeTest, PdfOptionsBinsRangeFramesAndLogScale) {
   import_table();
   // dr of frames 1 and 2: 5, 1, 2, 12, 0, 1. Four bins of width 3 over 0:12.
   granmem_ok({"analyze", "run.h5", "--out", "lin", "--pdf", "dr", "--pdf-bins", "4", "--pdf-range",
-              "0:12", "--pdf-frames", "1:2"});
+              "0:12", "--window", "1:2"});
   EXPECT_FALSE(fs::exists(in_work("lin") / "pdf_theta_axis_deg.csv"));
   const Table lin = read_columns(in_work("lin") / "pdf_dr.csv",
                                  {"bin_lo", "bin_hi", "bin_center", "count", "density"});
@@ -227,7 +228,7 @@ TEST_F(ImportAnalyzeTest, PdfOptionsBinsRangeFramesAndLogScale) {
 
   // Only frame 2 (12, 0, 1), log bins 1:4:16; the zero counts in the normalisation only.
   granmem_ok({"analyze", "run.h5", "--out", "log", "--pdf", "dr,dz", "--pdf-bins", "2",
-              "--pdf-range", "1:16", "--pdf-scale", "log", "--pdf-frames", "2:2"});
+              "--pdf-range", "1:16", "--pdf-scale", "log", "--window", "2:2"});
   const Table log = read_columns(in_work("log") / "pdf_dr.csv",
                                  {"bin_lo", "bin_hi", "bin_center", "count", "density"});
   expect_column(log, "bin_lo", {1, 4});
@@ -266,7 +267,7 @@ TEST_F(ImportAnalyzeTest, HoleContactPolicies) {
 }
 
 TEST_F(ImportAnalyzeTest, WallDistanceWithTheImportedBoxOrAGivenBox) {
-  import_table({"--box", "0,0,0,40,40,40"});
+  import_table({"--container", "0,0,0,40,40,40"});
   // 5 mm: grain 10 starts on the wall (0,0,0), so only 20 and 40 remain.
   granmem_ok({"analyze", "run.h5", "--out", "w5", "--wall-distance", "5"});
   expect_column(displacements("w5"), "particle", {20, 40, 20, 40});
@@ -276,7 +277,7 @@ TEST_F(ImportAnalyzeTest, WallDistanceWithTheImportedBoxOrAGivenBox) {
   expect_column(d, "frame", {1, 1, 2});
   expect_column(d, "particle", {20, 40, 20});
   // A larger box given to analyze replaces the run's box: every grain is far from its walls.
-  granmem_ok({"analyze", "run.h5", "--out", "big", "--wall-distance", "5", "--box",
+  granmem_ok({"analyze", "run.h5", "--out", "big", "--wall-distance", "5", "--container",
               "-100,-100,-100,100,100,100"});
   expect_column(displacements("big"), "particle", {10, 20, 40, 10, 20, 40});
 }

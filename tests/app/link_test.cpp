@@ -171,8 +171,8 @@ TEST_F(LinkCommandTest, NoDriftLosesTheGrains) {
   // grain is found again, without it most are not.
   granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "drift.h5", "--max-displacement", "0.4"});
   EXPECT_EQ(read_trajectories(in_work("drift.h5")).header.grain_count(), std::size_t(kGrains));
-  granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "t.h5", "--no-drift", "--max-displacement",
-              "400um"});
+  granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "t.h5", "--no-collective-motion",
+              "--max-displacement", "400um"});
   const Trajectories run = read_trajectories(in_work("t.h5"));
   EXPECT_GT(run.header.grain_count(), std::size_t(kGrains + 150));
   EXPECT_EQ(run.header.parameters.at("link/drift"), "off");

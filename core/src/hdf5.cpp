@@ -62,10 +62,29 @@ Handle dataspace(const std::vector<hsize_t>& dims, const std::vector<hsize_t>* m
                 H5Sclose);
 }
 
-Handle string_type() {
+// The memory type for reading variable-length strings of the file's character set (HDF5
+// does not convert between ASCII and UTF-8).
+Handle string_type(H5T_cset_t cset) {
   Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
   H5Tset_size(t.get(), H5T_VARIABLE);
-  H5Tset_cset(t.get(), H5T_CSET_UTF8);
+  H5Tset_cset(t.get(), cset);
+  return t;
+}
+
+// Strings are written fixed-length and null-terminated, as H5MD 1.1 requires of its
+// attributes: ASCII where every byte is, else UTF-8.
+Handle fixed_string_type(const std::vector<std::string>& values) {
+  std::size_t longest = 0;
+  bool ascii = true;
+  for (const std::string& v : values) {
+    longest = std::max(longest, v.size());
+    for (unsigned char c : v)
+      ascii = ascii && c < 0x80;
+  }
+  Handle t(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(t.get(), longest + 1);
+  H5Tset_strpad(t.get(), H5T_STR_NULLTERM);
+  H5Tset_cset(t.get(), ascii ? H5T_CSET_ASCII : H5T_CSET_UTF8);
   return t;
 }
 
@@ -82,7 +101,7 @@ std::vector<std::string> read_string_list_attribute(hid_t obj, const std::string
   const hssize_t n = H5Sget_simple_extent_npoints(space.get());
   std::vector<std::string> out;
   if (H5Tis_variable_str(type.get()) > 0) {
-    Handle mem = string_type();
+    Handle mem = string_type(H5Tget_cset(type.get()));
     std::vector<char*> ptrs(static_cast<std::size_t>(n), nullptr);
     check(H5Aread(attr.get(), mem.get(), ptrs.data()), "HDF5: cannot read attribute " + name);
     for (char* p : ptrs) {
@@ -93,9 +112,12 @@ std::vector<std::string> read_string_list_attribute(hid_t obj, const std::string
     const std::size_t size = H5Tget_size(type.get());
     std::vector<char> buf(size * static_cast<std::size_t>(n) + 1, '\0');
     check(H5Aread(attr.get(), type.get(), buf.data()), "HDF5: cannot read attribute " + name);
+    const bool space_padded = H5Tget_strpad(type.get()) == H5T_STR_SPACEPAD;
     for (hssize_t i = 0; i < n; ++i) {
       const char* p = buf.data() + static_cast<std::size_t>(i) * size;
-      out.emplace_back(p, strnlen(p, size));
+      std::string s(p, strnlen(p, size));
+      if (space_padded) s.erase(s.find_last_not_of(' ') + 1);
+      out.push_back(std::move(s));
     }
   }
   return out;
@@ -255,7 +277,7 @@ void write(hid_t loc, const std::string& name, const T* data, const std::vector<
     check(H5Dwrite(set.get(), Type<T>::memory(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
           "HDF5: cannot write dataset " + name);
   }
-  write_attribute(set.get(), "unit", unit.empty() ? std::string("1") : unit);
+  if (!unit.empty()) write_attribute(set.get(), "unit", unit);
 }
 
 template <class T>
@@ -291,7 +313,7 @@ Handle create_frames(hid_t loc, const std::string& name, const std::vector<hsize
                                  dcpl.get(), H5P_DEFAULT),
                       "HDF5: cannot create dataset " + name),
              H5Dclose);
-  write_attribute(set.get(), "unit", unit.empty() ? std::string("1") : unit);
+  if (!unit.empty()) write_attribute(set.get(), "unit", unit);
   return set;
 }
 
@@ -356,6 +378,21 @@ GRANMEM_H5_INSTANTIATE(std::int64_t)
 GRANMEM_H5_INSTANTIATE(std::uint8_t)
 #undef GRANMEM_H5_INSTANTIATE
 
+std::optional<double> read_number_attribute(hid_t obj, const std::string& name) {
+  quiet_hdf5();
+  if (H5Aexists(obj, name.c_str()) <= 0) return std::nullopt;
+  Handle attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose);
+  Handle type(H5Aget_type(attr.get()), H5Tclose);
+  Handle space(H5Aget_space(attr.get()), H5Sclose);
+  const H5T_class_t c = H5Tget_class(type.get());
+  if ((c != H5T_INTEGER && c != H5T_FLOAT) || H5Sget_simple_extent_npoints(space.get()) != 1) {
+    return std::nullopt;
+  }
+  double v = 0;
+  if (H5Aread(attr.get(), H5T_NATIVE_DOUBLE, &v) < 0) return std::nullopt;
+  return v;
+}
+
 void write_attribute(hid_t obj, const std::string& name, const std::string& value) {
   write_attribute(obj, name, std::vector<std::string>{value});
 }
@@ -363,17 +400,18 @@ void write_attribute(hid_t obj, const std::string& name, const std::string& valu
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values) {
   quiet_hdf5();
   if (H5Aexists(obj, name.c_str()) > 0) H5Adelete(obj, name.c_str());
-  Handle type = string_type();
+  Handle type = fixed_string_type(values);
   // A single string is a scalar attribute, as h5py and H5MD readers expect.
   Handle space = values.size() == 1 ? dataspace({}) : dataspace({values.size()});
   Handle attr(
       check_id(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
                "HDF5: cannot create attribute " + name),
       H5Aclose);
-  std::vector<const char*> ptrs;
-  for (const std::string& v : values)
-    ptrs.push_back(v.c_str());
-  check(H5Awrite(attr.get(), type.get(), ptrs.data()), "HDF5: cannot write attribute " + name);
+  const std::size_t size = H5Tget_size(type.get());
+  std::vector<char> packed(size * values.size(), '\0');
+  for (std::size_t i = 0; i < values.size(); ++i)
+    std::copy(values[i].begin(), values[i].end(), packed.begin() + std::ptrdiff_t(i * size));
+  check(H5Awrite(attr.get(), type.get(), packed.data()), "HDF5: cannot write attribute " + name);
 }
 
 void write_attribute(hid_t obj, const std::string& name, const std::vector<int>& values) {
@@ -433,8 +471,11 @@ std::vector<DatasetInfo> list_datasets(const File& file, const std::string& grou
       std::vector<DatasetInfo> inner = list_datasets(file, prefix + name);
       out.insert(out.end(), inner.begin(), inner.end());
     } else if (type == H5I_DATASET) {
-      out.push_back({prefix + name, shape(member.get()),
-                     read_string_attribute(member.get(), "unit").value_or("")});
+      // A unit H5MD has a symbol for, or one of granmem's own (voxel, cycle).
+      const std::string unit =
+          read_string_attribute(member.get(), "unit")
+              .value_or(read_string_attribute(member.get(), "granmem_unit").value_or(""));
+      out.push_back({prefix + name, shape(member.get()), unit});
     }
   }
   return out;
@@ -450,9 +491,9 @@ void write_table(hid_t loc, const std::string& group, const Table& table) {
       std::vector<std::int64_t> ints(c.values.size());
       std::transform(c.values.begin(), c.values.end(), ints.begin(),
                      [](double v) { return static_cast<std::int64_t>(v); });
-      write(g.get(), c.name, ints.data(), dims, c.unit);
+      write(g.get(), c.name, ints.data(), dims, c.unit.empty() ? "1" : c.unit);
     } else {
-      write(g.get(), c.name, c.values.data(), dims, c.unit);
+      write(g.get(), c.name, c.values.data(), dims, c.unit.empty() ? "1" : c.unit);
     }
   }
   write_attribute(g.get(), "columns", order);

@@ -1,6 +1,7 @@
 #include "granmem/core/trajectory_store.hpp"
 
 #include <cstdlib>
+#include <set>
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
@@ -13,6 +14,36 @@ namespace {
 
 constexpr const char* kGrains = "/particles/grains";
 
+// H5MD's units module (system SI) allows unit symbols such as cm, s, N; granmem's voxel and
+// cycle are none, and a dimensionless quantity has no unit: those go in an attribute of
+// granmem's own, `granmem_unit`, which other readers ignore.
+bool is_h5md_unit(const std::string& unit) {
+  static const std::set<std::string> si{"m", "cm", "mm", "um", "s", "N", "J", "Pa", "kg"};
+  return si.count(unit) > 0;
+}
+std::string h5md_unit(const std::string& unit) {
+  return is_h5md_unit(unit) ? unit : std::string();
+}
+void mark_granmem_unit(hid_t obj, const std::string& unit) {
+  if (!unit.empty() && unit != "1" && !is_h5md_unit(unit)) {
+    h5::write_attribute(obj, "granmem_unit", unit);
+  }
+}
+template <class T>
+void write_with_unit(hid_t loc, const std::string& name, const T* data,
+                     const std::vector<hsize_t>& dims, const std::string& unit) {
+  h5::write(loc, name, data, dims, h5md_unit(unit));
+  if (!is_h5md_unit(unit) && unit != "1" && !unit.empty()) {
+    const h5::Handle set(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
+    mark_granmem_unit(set.get(), unit);
+  }
+}
+// A dataset's unit as granmem wrote it (H5MD's `unit`, else `granmem_unit`), or `fallback`.
+std::string unit_of(hid_t obj, const std::string& fallback) {
+  if (auto u = h5::read_string_attribute(obj, "unit")) return *u;
+  return h5::read_string_attribute(obj, "granmem_unit").value_or(fallback);
+}
+
 // A time-dependent H5MD element: value[T,...], step[T], time[T], grown frame by frame.
 struct ElementWriter {
   h5::Handle group, value, step, time;
@@ -23,9 +54,11 @@ struct ElementWriter {
                               const std::string& time_unit) {
     ElementWriter e;
     e.group = h5::create_group(file, path);
-    e.value = h5::create_frames<T>(e.group.get(), "value", frame_dims, unit);
-    e.step = h5::create_frames<std::int64_t>(e.group.get(), "step", {}, "1");
-    e.time = h5::create_frames<double>(e.group.get(), "time", {}, time_unit);
+    e.value = h5::create_frames<T>(e.group.get(), "value", frame_dims, h5md_unit(unit));
+    mark_granmem_unit(e.value.get(), unit);
+    e.step = h5::create_frames<std::int64_t>(e.group.get(), "step", {}, "");
+    e.time = h5::create_frames<double>(e.group.get(), "time", {}, h5md_unit(time_unit));
+    mark_granmem_unit(e.time.get(), time_unit);
     return e;
   }
 
@@ -68,7 +101,7 @@ void write_run_parameters(hid_t file, const RunHeader& h) {
   write_parameters(file, h.parameters);
   if (h.voxel_size) {
     h5::Handle params = h5::create_group(file, "/parameters");
-    h5::write(params.get(), "voxel_size", h.voxel_size->data(), {3}, h.length_unit);
+    write_with_unit(params.get(), "voxel_size", h.voxel_size->data(), {3}, h.length_unit);
   }
 }
 
@@ -84,6 +117,20 @@ void read_parameters(const h5::File& file, const std::string& path, const std::s
       read_parameters(file, path + "/" + name, prefix + name + "/", out);
     }
   }
+}
+
+// An H5MD element's step or time: one entry per frame, or (H5MD's fixed interval) a scalar
+// increment with an optional `offset`: entry i = i x increment + offset.
+template <class T>
+std::vector<T> frame_labels(const h5::File& file, const std::string& path, hsize_t frames) {
+  const h5::Handle set = h5::open_dataset(file, path);
+  std::vector<T> v = h5::read<T>(file, path);
+  if (!h5::shape(set.get()).empty()) return v;
+  const double offset = h5::read_number_attribute(set.get(), "offset").value_or(0);
+  std::vector<T> out(frames);
+  for (hsize_t i = 0; i < frames; ++i)
+    out[i] = static_cast<T>(double(i) * double(v.at(0)) + offset);
+  return out;
 }
 
 std::string default_author() {
@@ -124,9 +171,9 @@ struct TrajectoryWriter::Impl {
     for (const auto& [name, obs] : observables) {
       h5::Handle g = h5::create_group(file.id(), "/observables/" + name);
       const std::vector<hsize_t> dims{obs.value.size()};
-      h5::write(g.get(), "value", obs.value.data(), dims, obs.unit);
-      h5::write(g.get(), "step", obs.step.data(), dims, "1");
-      h5::write(g.get(), "time", obs.time.data(), dims, header.time_unit);
+      write_with_unit(g.get(), "value", obs.value.data(), dims, obs.unit);
+      h5::write(g.get(), "step", obs.step.data(), dims, "");
+      write_with_unit(g.get(), "time", obs.time.data(), dims, header.time_unit);
     }
   }
 };
@@ -146,16 +193,19 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader 
   h5::write_attribute(creator.get(), "name", h.creator_name);
   h5::write_attribute(creator.get(), "version",
                       h.creator_version.empty() ? std::string(kVersion) : h.creator_version);
+  h5::Handle units = h5::create_group(h5md.get(), "modules/units");
+  h5::write_attribute(units.get(), "version", std::vector<int>{1, 0});
+  h5::write_attribute(units.get(), "system", std::string("SI"));
 
   h5::Handle grains = h5::create_group(f, kGrains);
-  h5::write(grains.get(), "id", h.id.data(), {n}, "1");
-  h5::write(grains.get(), "radius", h.radius.data(), {n}, h.length_unit);
+  h5::write(grains.get(), "id", h.id.data(), {n}, "");
+  write_with_unit(grains.get(), "radius", h.radius.data(), {n}, h.length_unit);
   h5::Handle box = h5::create_group(grains.get(), "box");
   h5::write_attribute(box.get(), "dimension", std::vector<int>{3});
   h5::write_attribute(box.get(), "boundary", std::vector<std::string>{"none", "none", "none"});
   if (h.box) {
-    h5::write(box.get(), "edges", h.box->edges.data(), {3}, h.length_unit);
-    h5::write(box.get(), "offset", h.box->lower.data(), {3}, h.length_unit);
+    write_with_unit(box.get(), "edges", h.box->edges.data(), {3}, h.length_unit);
+    write_with_unit(box.get(), "offset", h.box->lower.data(), {3}, h.length_unit);
   }
 
   impl_->position = ElementWriter::create<double>(f, std::string(kGrains) + "/position", {n, 3},
@@ -163,15 +213,15 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader 
   h5::write_attribute(impl_->position.group.get(), "sample", h.sample);
   if (h.has_axis) {
     impl_->axis =
-        ElementWriter::create<double>(f, std::string(kGrains) + "/axis", {n, 3}, "1", h.time_unit);
+        ElementWriter::create<double>(f, std::string(kGrains) + "/axis", {n, 3}, "", h.time_unit);
   }
   if (h.has_orientation) {
     impl_->orientation = ElementWriter::create<double>(f, std::string(kGrains) + "/orientation",
-                                                       {n, 4}, "1", h.time_unit);
+                                                       {n, 4}, "", h.time_unit);
   }
   if (h.has_hole_contact) {
     impl_->hole_contact = ElementWriter::create<std::uint8_t>(
-        f, std::string(kGrains) + "/hole_contact", {n}, "1", h.time_unit);
+        f, std::string(kGrains) + "/hole_contact", {n}, "", h.time_unit);
   }
 
   write_run_parameters(f, h);
@@ -340,22 +390,29 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
                 ", expected [frames,grains,3]");
   }
   const hsize_t t_count = dims[0], n = dims[1];
-  r.steps = h5::read<std::int64_t>(r.file, pos + "/step");
-  r.times = h5::read<double>(r.file, pos + "/time");
+  RunHeader& h = r.header;
+  // H5MD makes `time` optional: frames are then known by their step alone.
+  r.steps = frame_labels<std::int64_t>(r.file, pos + "/step", t_count);
+  if (h5::exists(f, pos + "/time")) {
+    r.times = frame_labels<double>(r.file, pos + "/time", t_count);
+    h.time_unit = unit_of(h5::open_dataset(r.file, pos + "/time").get(), "s");
+  } else {
+    r.times.assign(r.steps.begin(), r.steps.end());
+    h.time_unit = "step";
+  }
   if (r.steps.size() != t_count || r.times.size() != t_count) {
     throw Error(name + ": " + pos + "/step and /time must have one entry per frame (" +
                 std::to_string(t_count) + ")");
   }
 
-  RunHeader& h = r.header;
-  h.length_unit = h5::read_string_attribute(r.position.get(), "unit").value_or("");
+  // H5MD makes `unit` optional: a file without one is taken in metres, and says so.
+  const std::string stated_unit = unit_of(r.position.get(), "");
+  h.length_unit = stated_unit.empty() ? "m" : stated_unit;
   if (!is_length_unit(h.length_unit)) {
     throw Error(name + ": dataset " + pos + "/value has unit '" + h.length_unit +
                 "', expected one of m, cm, mm, um, voxel");
   }
   {
-    h5::Handle time = h5::open_dataset(r.file, pos + "/time");
-    h.time_unit = h5::read_string_attribute(time.get(), "unit").value_or("1");
     h5::Handle group = h5::open_group(r.file, pos);
     h.sample = h5::read_string_attribute(group.get(), "sample").value_or(kSampleEndOfCycle);
   }
@@ -430,6 +487,8 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
       h.voxel_size = Eigen::Vector3d(v[0], v[1], v[2]);
     }
   }
+  if (stated_unit.empty())
+    h.parameters["h5md/length_unit"] = "m, assumed: the file's positions have no unit";
   check_header(h, name);
 
   if (h5::exists(f, "/observables")) {
@@ -441,7 +500,7 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
       ob.step = h5::read<std::int64_t>(r.file, base + "/step");
       ob.time = h5::read<double>(r.file, base + "/time");
       h5::Handle value = h5::open_dataset(r.file, base + "/value");
-      ob.unit = h5::read_string_attribute(value.get(), "unit").value_or("1");
+      ob.unit = unit_of(value.get(), "1");
       if (ob.step.size() != ob.value.size() || ob.time.size() != ob.value.size()) {
         throw Error(name + ": observable " + base + " needs value, step and time of equal length");
       }

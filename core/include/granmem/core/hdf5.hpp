@@ -12,8 +12,9 @@
 #include "granmem/core/table.hpp"
 
 // A thin layer over the HDF5 C library: owned identifiers, whole-dataset and per-frame
-// reads and writes with a `unit` attribute on every dataset, and messages that name the
-// file and the dataset. HDF5's own error printing is switched off; failures throw Error.
+// reads and writes with a `unit` attribute on datasets that have one, fixed-length string
+// attributes (as H5MD requires; both kinds are read), and messages that name the file and
+// the dataset. HDF5's own error printing is switched off; failures throw Error.
 namespace granmem::h5 {
 
 class Handle {
@@ -61,7 +62,7 @@ Handle open_dataset(const File& file, const std::string& path);
 std::vector<hsize_t> shape(hid_t dataset);
 std::string shape_text(const std::vector<hsize_t>& dims);  // "[3,10,3]"
 
-// Whole datasets of double, int64 or uint8, with a `unit` attribute ("1" if dimensionless).
+// Whole datasets of double, int64 or uint8, with a `unit` attribute unless `unit` is empty.
 template <class T>
 void write(hid_t loc, const std::string& name, const T* data, const std::vector<hsize_t>& dims,
            const std::string& unit);
@@ -85,6 +86,8 @@ void write_attribute(hid_t obj, const std::string& name, const std::string& valu
 void write_attribute(hid_t obj, const std::string& name, const std::vector<std::string>& values);
 void write_attribute(hid_t obj, const std::string& name, const std::vector<int>& values);
 std::optional<std::string> read_string_attribute(hid_t obj, const std::string& name);
+// A scalar numeric attribute (an H5MD `offset`), as a double; none if absent or not a number.
+std::optional<double> read_number_attribute(hid_t obj, const std::string& name);
 std::vector<std::string> attribute_names(hid_t obj);
 std::vector<std::string> member_names(hid_t group);
 

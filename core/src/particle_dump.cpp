@@ -1,6 +1,7 @@
 #include "granmem/core/particle_dump.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <limits>
@@ -11,6 +12,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectory_table.hpp"
+#include "granmem/core/units.hpp"
 
 namespace granmem {
 namespace {
@@ -151,6 +153,86 @@ void write_particle_dump(const TrajectoryReader& run, const std::filesystem::pat
     s << text;
     text.clear();
   }
+  s.close();
+  if (!s) throw Error(out.string() + ": write failed (disk full?)");
+  file.commit();
+}
+
+namespace {
+
+double grain_density(const RunHeader& h, std::optional<double> given,
+                     const std::filesystem::path& out) {
+  if (given) return *given;
+  const auto simulated = h.parameters.find("simulate/density");
+  if (simulated == h.parameters.end()) {
+    throw Error(out.string() +
+                ": the run does not say its grains' density; give it (e.g. 1.18g/cm^3)");
+  }
+  return parse_si(simulated->second, Dimension::density, "", "simulate/density");
+}
+
+}  // namespace
+
+void write_lammps_data(const TrajectoryReader& run, std::optional<std::size_t> frame,
+                       std::optional<double> given_density, const std::filesystem::path& out) {
+  const RunHeader& h = run.header();
+  const double density = grain_density(h, given_density, out);
+  const std::size_t frame_index = frame.value_or(run.frame_count() - 1);
+  if (!is_physical_length_unit(h.length_unit)) {
+    throw Error(out.string() + ": a LAMMPS data file needs lengths; the run is in " +
+                h.length_unit + " (import it with --voxel-size)");
+  }
+  if (!(density > 0) || !std::isfinite(density)) {
+    throw Error(out.string() + ": the grains' density must be positive");
+  }
+  if (run.frame_count() == 0 || frame_index >= run.frame_count()) {
+    throw Error(out.string() + ": the run has no frame " + std::to_string(frame_index) + " (" +
+                std::to_string(run.frame_count()) + " frames)");
+  }
+  check_lammps_ids(h.id, out);
+  const double m = metres_per(h.length_unit);
+  const Frame f = run.read_frame(frame_index);
+  Box box = frame_box(h, f);
+  if (!h.box) {  // the grains' bounding box, widened so that every grain lies inside it
+    double largest = 0;
+    for (double r : h.radius)
+      if (std::isfinite(r)) largest = std::max(largest, r);
+    box.lower.array() -= largest;
+    box.edges.array() += 2 * largest;
+  }
+  std::string atoms;
+  std::size_t count = 0;
+  for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
+    if (!f.position.row(i).allFinite()) continue;
+    const double r = h.radius[std::size_t(i)];
+    if (!(r > 0) || !std::isfinite(r)) {
+      throw Error(out.string() + ": grain " + std::to_string(h.id[std::size_t(i)]) +
+                  " has no radius; a data file needs every grain's diameter");
+    }
+    atoms += std::to_string(h.id[std::size_t(i)] + 1) + " 1";
+    for (double v :
+         {2 * r * m, density, f.position(i, 0) * m, f.position(i, 1) * m, f.position(i, 2) * m}) {
+      atoms += ' ';
+      number(atoms, v);
+    }
+    atoms += '\n';
+    ++count;
+  }
+  std::string text = "LAMMPS data file (units si, atom_style sphere) from granmem: frame " +
+                     std::to_string(frame_index) + " (step " + std::to_string(f.step) + ") of " +
+                     run.file_name() + "\n\n" + std::to_string(count) + " atoms\n1 atom types\n\n";
+  const char* axes[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    number(text, box.lower[k] * m);
+    text += ' ';
+    number(text, (box.lower[k] + box.edges[k]) * m);
+    text += std::string(" ") + axes[k] + "lo " + axes[k] + "hi\n";
+  }
+  text += "\nAtoms # sphere\n\n" + atoms;
+  AtomicFile file(out);
+  std::ofstream s(file.temp_path(), std::ios::binary);
+  if (!s) throw Error(out.string() + ": cannot open for writing");
+  s << text;
   s.close();
   if (!s) throw Error(out.string() + ": write failed (disk full?)");
   file.commit();

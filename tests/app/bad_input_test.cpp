@@ -449,7 +449,7 @@ TEST_F(BadInputTest, AnalyzeBadOptions) {
 TEST_F(BadInputTest, ExportBadOptions) {
   make_good_outputs();
   expect_clean_failure({"export", "run.h5", "--out", "x.txt"},
-                       {"--out x.txt: say --format lammps, extxyz or csv"});
+                       {"--out x.txt: say --format lammps, extxyz, csv or lammps-data"});
   expect_clean_failure({"export", "run.h5", "--out", "x.dump", "--format", "pdb"},
                        {"--format", "pdb"});
   expect_clean_failure({"export", "run.h5", "--out", "nofolder/x.dump"},

@@ -314,6 +314,45 @@ TEST_F(LammpsRoundTrip, ADumpWrittenByLammpsImportsAsTheSameGrains) {
 #endif
 }
 
+// A frame as a LAMMPS data file: LAMMPS starts from it with every grain (id + 1), its
+// diameter, its mass from the density, at its place in metres.
+TEST_F(LammpsRoundTrip, ADataFileStartsALammpsRun) {
+#ifndef GRANMEM_LAMMPS_EXE
+  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
+#else
+  write_text(in_work("t.csv"),
+             "frame,particle,x,y,z,radius\n0,4,1,2,3,0.5\n0,9,4,5,6,0.75\n"
+             "1,4,1,2,3.5,0.5\n1,9,4,5,6.25,0.75\n");
+  granmem_ok({"import", "t.csv", "--out", "run.h5", "--length-unit", "mm"});
+  expect_clean_failure({"export", "run.h5", "--out", "run.data"}, {"density"});
+  granmem_ok({"export", "run.h5", "--out", "run.data", "--frame", "0", "--density", "1.2g/cm^3"});
+  write_text(in_work("start.lmp"),
+             "units si\natom_style sphere\nboundary f f f\nread_data run.data\n"
+             "write_dump all custom back.dump id x y z diameter mass modify sort id "
+             "format float %.17g\n");
+  const std::string cmd = "cd " + testing::shell_quote(work().string()) + " && " +
+                          testing::shell_quote(GRANMEM_LAMMPS_EXE) +
+                          " -in start.lmp -log none -screen none > lmp.out 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << read_text(in_work("lmp.out"));
+  std::istringstream back(read_text(in_work("back.dump")));
+  std::string line;
+  while (std::getline(back, line) && line.rfind("ITEM: ATOMS", 0) != 0) {
+  }
+  std::vector<std::vector<double> > atoms;
+  for (double id, x, y, z, d, m; back >> id >> x >> y >> z >> d >> m;)
+    atoms.push_back({id, x, y, z, d, m});
+  ASSERT_EQ(atoms.size(), 2u);
+  const double pi = std::acos(-1.0);
+  const std::vector<std::vector<double> > expected{
+      {5, 1e-3, 2e-3, 3e-3, 1e-3, 1200 * pi / 6 * 1e-9},
+      {10, 4e-3, 5e-3, 6e-3, 1.5e-3, 1200 * pi / 6 * 3.375e-9}};
+  for (std::size_t a = 0; a < 2; ++a) {
+    for (std::size_t k = 0; k < 6; ++k)
+      EXPECT_NEAR(atoms[a][k], expected[a][k], 1e-12 * std::abs(expected[a][k])) << a << " " << k;
+  }
+#endif
+}
+
 TEST_F(GranmemTest, ExportExtendedXyz) {
   write_text(in_work("t.csv"), kExportTable);
   granmem_ok({"import", "t.csv", "--out", "run.h5", "--length-unit", "mm"});

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 #include "granmem/core/trajectory_store.hpp"
 
@@ -23,5 +24,15 @@ enum class DumpFormat {
 // carry the grain id, so OVITO still tracks them). Written atomically.
 void write_particle_dump(const TrajectoryReader& run, const std::filesystem::path& out,
                          DumpFormat format);
+
+// One frame of a run as a LAMMPS data file that `read_data` starts a run from (`units si`,
+// `atom_style sphere`): the box (the run's container, else the grains' bounding box), and
+// one atom per grain seen in the frame, id = grain id + 1, type 1, its diameter and
+// density, at rest. Lengths are converted to metres. `frame`: by index, default the last;
+// `density` in kg/m^3, default the simulation's (the run's simulate/density). Throws Error
+// for a run in voxels, a grain without a radius, a density neither given nor recorded or
+// not positive, a frame the run does not have. Written atomically.
+void write_lammps_data(const TrajectoryReader& run, std::optional<std::size_t> frame,
+                       std::optional<double> density, const std::filesystem::path& out);
 
 }  // namespace granmem

@@ -125,6 +125,7 @@ class GranmemTest : public TempDirTest {
     EXPECT_EQ(lines.size(), 1u) << "stderr:\n" << r.err;
     EXPECT_TRUE(!r.err.empty() && r.err.back() == '\n') << r.err;
     const std::string first = lines.empty() ? "" : lines[0];
+    log_bad_input(cmd, r.exit_code, first);
     EXPECT_EQ(first.rfind("granmem: error: ", 0), 0u) << first;
     for (const std::string& e : expected)
       EXPECT_NE(first.find(e), std::string::npos) << "expected '" << e << "' in: " << first;
@@ -140,6 +141,17 @@ class GranmemTest : public TempDirTest {
       else
         EXPECT_TRUE(it->second == text) << "changed: " << name;
     }
+  }
+
+  // With GRANMEM_BAD_INPUT_LOG set, every refused input is appended to that file (test,
+  // command, exit status, message; tab-separated): scripts/bad_input_table.sh makes
+  // docs/BAD_INPUT.md from it, so that the table lists what the tests assert.
+  static void log_bad_input(const std::string& cmd, int code, const std::string& message) {
+    const char* log = std::getenv("GRANMEM_BAD_INPUT_LOG");
+    if (!log || !*log) return;
+    const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::ofstream(log, std::ios::app) << test->test_suite_name() << "." << test->name() << "\t"
+                                      << cmd << "\t" << code << "\t" << message << "\n";
   }
 
   // Reads `columns` of a CSV written by granmem.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/statistics.hpp"
 
 namespace granmem {
 namespace {
@@ -16,8 +17,7 @@ constexpr std::size_t kMinVoxels = 32;
 constexpr std::size_t kMinLineVoxels = 8;
 
 double median_in_place(std::vector<double>& v) {
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-  return v[v.size() / 2];
+  return quantile_in_place(v, 0.5);
 }
 
 // Each slice's value replaced by the median over the slices within `reach` of it that
@@ -67,11 +67,7 @@ void fluid_grain_split(const Stack& stack, const IlluminationOptions& o, std::in
     for (std::int64_t z = 0; z < stack.nz; ++z) {
       const std::uint16_t* slice = stack.slice(z);
       sample.assign(slice, slice + stack.nx * stack.ny);
-      const auto q = [&](double p) {
-        const auto i = std::size_t(p * double(sample.size() - 1));
-        std::nth_element(sample.begin(), sample.begin() + std::ptrdiff_t(i), sample.end());
-        return sample[i];
-      };
+      const auto q = [&](double p) { return quantile_in_place(sample, p); };
       const double high = q(o.fluid_percentile), low = q(o.grain_percentile);
       const auto zi = std::size_t(z);
       fluid[zi] = o.dark_grains ? high : low;
@@ -315,11 +311,7 @@ void normalize_levels(Stack& stack, const IlluminationOptions& o) {
   for (std::size_t k = 0; k < stack.voxels.size(); k += every)
     sample.push_back(stack.voxels[k]);
   if (sample.empty()) return;
-  const auto at = [&](double q) {
-    const auto i = std::size_t(q * double(sample.size() - 1));
-    std::nth_element(sample.begin(), sample.begin() + std::ptrdiff_t(i), sample.end());
-    return sample[i];
-  };
+  const auto at = [&](double q) { return quantile_in_place(sample, q); };
   const double high = at(o.fluid_percentile), low = at(o.grain_percentile);
   const double fluid = o.dark_grains ? high : low, grain = o.dark_grains ? low : high;
   const double span = std::abs(fluid - grain) > 1e-9 ? fluid - grain : 1.0;

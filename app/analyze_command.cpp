@@ -8,7 +8,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
 #include "granmem/core/units.hpp"
-#include "granmem/rotation/motion_analysis.hpp"
+#include "granmem/rotation/analyze_run.hpp"
 
 namespace granmem::app {
 namespace {
@@ -22,48 +22,14 @@ std::vector<std::string> split_list(const std::string& text) {
   return items;
 }
 
-// A few rows of the per-frame table, so the user sees the run's story at a glance.
-void print_per_frame(const Table& p, const std::string& unit) {
-  const std::size_t rows = p.rows();
-  std::cout << std::setw(7) << "frame" << std::setw(8) << "n" << std::setw(14) << "mean_dr"
-            << std::setw(14) << "median_dr" << std::setw(14) << "mean_theta"
-            << "\n"
-            << std::setw(29) << "[" + unit + "]" << std::setw(14) << "[" + unit + "]"
-            << std::setw(14) << "[deg]"
-            << "\n";
-  for (std::size_t r = 0; r < rows; ++r) {
-    if (rows > 12 && r == 5) {
-      std::cout << std::setw(7) << "..."
-                << "\n";
-      r = rows - 5;
-    }
-    std::cout << std::setprecision(5) << std::setw(7) << p["frame"].values[r] << std::setw(8)
-              << p["n"].values[r] << std::setw(14) << p["mean_dr"].values[r] << std::setw(14)
-              << p["median_dr"].values[r] << std::setw(14) << p["mean_theta_axis_deg"].values[r]
-              << "\n";
-  }
-}
-
 }  // namespace
 
 void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& options,
                         const std::string& out, const std::map<std::string, std::string>& used) {
-  const RunHeader& h = run.header();
-  const MotionAnalysis a = analyze_motion(run, options);
-  const auto written = write_motion_analysis(a, out, {"granmem analyze " + run.file_name()}, used);
-  for (const std::string& note : a.notes)
+  const AnalyzeSummary summary = analyze_run(run, options, out, used);
+  for (const std::string& note : summary.notes)
     std::cerr << "granmem: note: " << note << "\n";
-  const bool radius_known =
-      std::any_of(h.radius.begin(), h.radius.end(), [](double r) { return std::isfinite(r); });
-  if ((h.has_axis || h.has_orientation) && !radius_known) {
-    std::cerr << "granmem: note: " << run.file_name()
-              << " has no grain radius, so rot_disp is nan (import with --radius)\n";
-  }
-  std::cout << run.file_name() << ": " << a.displacements.rows() << " displacements over "
-            << a.per_frame.rows() << " frame pairs, lengths in " << a.length_unit << "\n";
-  print_per_frame(a.per_frame, a.length_unit);
-  for (const auto& path : written)
-    std::cout << "wrote " << path.string() << "\n";
+  std::cout << summary.Report();
 }
 
 void add_analyze(CLI::App& app) {

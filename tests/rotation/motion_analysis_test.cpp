@@ -14,6 +14,7 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/hdf5.hpp"
+#include "granmem/rotation/analyze_run.hpp"
 #include "temp_dir.hpp"
 
 #include "checks.hpp"
@@ -493,6 +494,44 @@ TEST_F(MotionAnalysisTest, NoGrainFollowedGivesTablesButNoPdfs) {
   EXPECT_EQ(a.per_frame["n"].values, (std::vector<double>{0, 0}));
   EXPECT_TRUE(a.pdfs.empty());
   ASSERT_EQ(a.notes.size(), 1u);
+}
+
+}  // namespace
+}  // namespace granmem
+
+namespace granmem {
+namespace {
+
+// analyze as one call: the tables written, the report's counts and rows, and a note where
+// rotations cannot become lengths (no radius).
+TEST_F(MotionAnalysisTest, AnalyzeRunWritesTheTablesAndReportsTheRun) {
+  const AnalyzeSummary s = analyze_run(stored(three_grain_run()), {}, path("out"), {});
+  EXPECT_TRUE(fs::exists(path("out") / "displacements.csv"));
+  EXPECT_TRUE(fs::exists(path("out") / "analysis.h5"));
+  EXPECT_EQ(std::count(s.written.begin(), s.written.end(), path("out") / "per_frame.csv"), 1);
+  const std::string report = s.Report();
+  // Grain 20 is not seen in frame 107: 3 + 2 displacements. Frame 105: dr 5, 2, 3 and axis
+  // turns 90, 0, 30 degrees; frame 107: dr 4, 3 and turns 0, 20.
+  EXPECT_EQ(
+      report.rfind(
+          path("run.h5").string() + ": 5 displacements over 2 frame pairs, lengths in mm\n", 0),
+      0u)
+      << report;
+  EXPECT_NE(report.find("\n    105       3        3.3333             3            40\n"
+                        "    107       2           3.5           3.5            10\n"),
+            std::string::npos)
+      << report;
+  EXPECT_NE(report.find("wrote " + (path("out") / "analysis.h5").string()), std::string::npos);
+  EXPECT_TRUE(std::none_of(s.notes.begin(), s.notes.end(), [](const std::string& n) {
+    return n.find("no grain radius") != std::string::npos;
+  }));
+
+  Trajectories no_radius = three_grain_run();
+  no_radius.header.radius.assign(3, std::numeric_limits<double>::quiet_NaN());
+  const AnalyzeSummary t = analyze_run(stored(no_radius, "bare.h5"), {}, path("bare"), {});
+  EXPECT_TRUE(std::any_of(t.notes.begin(), t.notes.end(), [](const std::string& n) {
+    return n.find("bare.h5 has no grain radius, so rot_disp is nan") != std::string::npos;
+  }));
 }
 
 }  // namespace

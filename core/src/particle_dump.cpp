@@ -1,5 +1,6 @@
 #include "granmem/core/particle_dump.hpp"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -120,11 +121,13 @@ void write_particle_dump(const TrajectoryReader& run, const std::filesystem::pat
           text += (k == 2 && j == 2) ? "\" Origin=\"" : " ";
         }
       }
+      std::string origin;
       for (int k = 0; k < 3; ++k) {
-        number(text, box.lower[k]);
-        text += k == 2 ? "\"" : " ";
+        number(origin, box.lower[k]);
+        origin += k == 2 ? "\"" : " ";
       }
-      text += " Properties=" + properties + " Time=";
+      // OVITO 3 reads the cell's corner as Origin, OVITO 2 and QUIP as cell_origin.
+      text += origin + " cell_origin=\"" + origin + " Properties=" + properties + " Time=";
       number(text, f.time);
       text += " Step=" + std::to_string(f.step) + " Units=" + h.length_unit + " pbc=\"F F F\"\n";
     }
@@ -144,7 +147,9 @@ void write_particle_dump(const TrajectoryReader& run, const std::filesystem::pat
           put(f.axis(i, k));
       }
       if (h.has_orientation) {
-        for (int k = 0; k < 4; ++k)
+        // LAMMPS's columns are named (quatw first); OVITO maps an extended XYZ
+        // `orientation` onto its Orientation property, whose components are X, Y, Z, W.
+        for (int k : lammps ? std::array<int, 4>{0, 1, 2, 3} : std::array<int, 4>{1, 2, 3, 0})
           put(f.orientation(i, k));
       }
       if (h.has_hole_contact) text += f.hole_contact[std::size_t(i)] ? " 1" : " 0";

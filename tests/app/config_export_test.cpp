@@ -365,7 +365,7 @@ TEST_F(GranmemTest, ExportExtendedXyz) {
   ASSERT_EQ(lines.size(), 14u);  // (2 + 3) + (2 + 2) + (2 + 3)
   EXPECT_EQ(lines[0], "3");
   EXPECT_EQ(lines[1],
-            "Lattice=\"6 0 0 0 6 0 0 0 6\" Origin=\"1 2 3\" "
+            "Lattice=\"6 0 0 0 6 0 0 0 6\" Origin=\"1 2 3\" cell_origin=\"1 2 3\" "
             "Properties=id:I:1:pos:R:3:radius:R:1:axis:R:3:hole_contact:I:1 Time=0 Step=0 "
             "Units=mm pbc=\"F F F\"");
   EXPECT_EQ(lines[2], "10 1 2 3 0.5 0 0 1 0");

@@ -115,6 +115,21 @@ TEST_F(ParticleDump, LammpsDumpWithOrientationAndNoBoxUsesTheBoundingBox) {
   EXPECT_EQ(read_text(out), expected);
 }
 
+// OVITO reads an extended XYZ `orientation` as its Orientation property, (X, Y, Z, W): the
+// scalar part goes last there, first in the LAMMPS dump's named columns.
+TEST_F(ParticleDump, ExtendedXyzOrientationIsOvitosXyzw) {
+  const TrajectoryReader run(tiny_run(true, true));
+  const fs::path out = path("turned.extxyz");
+  write_particle_dump(run, out, DumpFormat::extxyz);
+  const std::string text = read_text(out);
+  EXPECT_NE(text.find("Properties=id:I:1:pos:R:3:radius:R:1:axis:R:3:orientation:R:4:"),
+            std::string::npos)
+      << text;
+  // Frame 1, grain 20: q = (w 0.5, x -0.5, y 0.5, z -0.5), after its axis (0 1 0).
+  EXPECT_NE(text.find("\n20 1.5 -2.25 3 0.25 0 1 0 -0.5 0.5 -0.5 0.5 1\n"), std::string::npos)
+      << text;
+}
+
 TEST_F(ParticleDump, ExtendedXyzIsExact) {
   const TrajectoryReader run(tiny_run(true, false));
   const fs::path out = path("tiny.extxyz");
@@ -122,13 +137,13 @@ TEST_F(ParticleDump, ExtendedXyzIsExact) {
   const std::string properties = " Properties=id:I:1:pos:R:3:radius:R:1:axis:R:3:hole_contact:I:1 ";
   const std::string expected =
       "2\n"
-      "Lattice=\"2 0 0 0 3 0 0 0 4\" Origin=\"-1 0 0.5\"" +
+      "Lattice=\"2 0 0 0 3 0 0 0 4\" Origin=\"-1 0 0.5\" cell_origin=\"-1 0 0.5\"" +
       properties +
       "Time=0.5 Step=1 Units=mm pbc=\"F F F\"\n"
       "10 0.5 1 1.5 0.5 0 0 1 1\n"
       "20 1.25 2 3.5 0.25 1 0 0 0\n"
       "1\n"
-      "Lattice=\"2 0 0 0 3 0 0 0 4\" Origin=\"-1 0 0.5\"" +
+      "Lattice=\"2 0 0 0 3 0 0 0 4\" Origin=\"-1 0 0.5\" cell_origin=\"-1 0 0.5\"" +
       properties +
       "Time=1 Step=2 Units=mm pbc=\"F F F\"\n"
       "20 1.5 -2.25 3 0.25 0 1 0 1\n";

@@ -14,7 +14,10 @@ enum class DumpFormat {
   // [quatw quati quatj quatk] [hole_contact], where id is the granmem id + 1 (LAMMPS
   // numbers atoms from 1) and type is 1.
   lammps,
-  extxyz,  // extended XYZ with the same per-grain properties
+  // extended XYZ with the same per-grain properties, named as OVITO maps them (id, pos,
+  // radius, orientation as OVITO's Orientation: x, y, z, w), the box as Lattice with its
+  // corner as Origin and cell_origin.
+  extxyz,
   // trackpy's long table as CSV: frame, particle, time, x, y, z, radius, ... (the columns
   // of trajectory_table.hpp), for pandas, MATLAB and TrackMate users.
   csv,

@@ -137,5 +137,62 @@ TEST_F(Interruption, KilledOrStoppedRunsResumeToTheSameResultBitForBit) {
   }
 }
 
+// A read-out sweep killed outright after its first finished run: called again, it reuses
+// the runs that finished, redoes the others (their temporaries removed) and writes the
+// same table as a sweep never stopped.
+TEST_F(Interruption, AKilledReadoutSweepReusesItsFinishedRunsAndEndsTheSame) {
+  granmem_ok({"simulate", "--grains", "60", "--box", "2cm", "--amplitude", "2%",
+              "--inertial-number", "1e-2", "--cycles", "2", "--keep-states", "1", "--out",
+              "train.h5"});
+  // Slow read-out cycles (inertial number 3e-4: ~1 s a run), eight of them.
+  auto sweep = [](const std::string& out) {
+    return std::vector<std::string>{"readout",
+                                    "--from",
+                                    "train_state_cycle1.h5",
+                                    "--amplitudes",
+                                    "0.5%,1%,1.5%,2.5%,3%,3.5%,4%,5%",
+                                    "--inertial-number",
+                                    "3e-4",
+                                    "--out",
+                                    out};
+  };
+  granmem_ok(sweep("whole"));
+  const pid_t child = start(sweep("killed"));
+  bool finished_one = false;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+  while (!finished_one && std::chrono::steady_clock::now() < give_up) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(in_work("killed"), ec)) {
+      const std::string name = e.path().filename().string();
+      finished_one = finished_one || (name.rfind("readout_", 0) == 0 && name.size() > 3 &&
+                                      name.substr(name.size() - 3) == ".h5");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(finished_one) << "no run finished";
+  kill(child, SIGKILL);
+  EXPECT_EQ(wait_exit(child), 128 + SIGKILL);
+  EXPECT_FALSE(fs::exists(in_work("killed") / "readout.csv"));  // killed before the end
+
+  const RunResult again = granmem_ok(sweep("killed"));
+  const std::size_t at = again.out.find(" runs reused)");
+  ASSERT_NE(at, std::string::npos) << again.out;
+  const int reused = std::stoi(again.out.substr(again.out.rfind('(', at) + 1));
+  EXPECT_GE(reused, 1) << again.out;
+  EXPECT_LT(reused, 8) << again.out;
+  const std::vector<std::string> columns{"amplitude_pct", "dr_d", "msd_d2", "rot_single_d",
+                                         "rot_full_d"};
+  const Table whole = read_columns(in_work("whole") / "readout.csv", columns),
+              resumed = read_columns(in_work("killed") / "readout.csv", columns);
+  for (const std::string& c : columns)
+    EXPECT_EQ(whole[c].values, resumed[c].values) << c;
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(in_work("killed"))) {
+    if (e.path().filename().string().find(".tmp-") != std::string::npos)
+      left.push_back(e.path().filename().string());
+  }
+  EXPECT_TRUE(left.empty()) << left.front();
+}
+
 }  // namespace
 }  // namespace granmem

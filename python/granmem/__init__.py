@@ -82,17 +82,19 @@ def render(grains, length_unit="m", diameter_px=20, slice_spacing_ratio=1, clean
 
 
 def locate(stack, diameter, voxel_size=None, unit="", frame=0, polarity="dark",
-           hole_fraction=0.3, beam="x", axis="fit", passes=4, illumination=True):
+           hole_fraction=0.3, beam="x", axis="fit", passes=4, illumination=True, progress=None):
     """Every grain of one scan: centre, radius, hole axis and quality, as ``granmem locate``.
 
     ``stack`` is a (z, y, x) uint8/uint16 array (left unchanged); ``diameter`` in voxels
     along x (12) or a length ("5mm") with ``voxel_size`` (x, y, z) in ``unit``. Returns a
     DataFrame: frame, particle (the detection's index), x, y, z, radius, quality, edge, and
     with holes ax, ay, az, axis_quality, hole_contact; lengths in ``attrs["length_unit"]``
-    (the voxel size's unit, or voxels), the run's numbers in ``attrs["summary"]``."""
+    (the voxel size's unit, or voxels), the run's numbers in ``attrs["summary"]``.
+    ``progress``: called with a dict ``{"line": stage}`` as each stage begins; Ctrl-C stops
+    between two stages (KeyboardInterrupt)."""
     columns, units, summary = _granmem.locate(
         stack, str(diameter), _vector3(voxel_size), unit, int(frame), polarity,
-        float(hole_fraction), beam, axis, int(passes), bool(illumination))
+        float(hole_fraction), beam, axis, int(passes), bool(illumination), progress)
     return _frame(columns, units, length_unit=summary["length_unit"],
                   voxel_size=summary["voxel_size"], summary=summary)
 
@@ -120,7 +122,7 @@ def _scans(detections):
 
 
 def link(detections, length_unit=None, voxel_size=None, max_displacement="auto", memory=2,
-         drift=True, container=None, container_size=None):
+         collective_motion=True, container=None, container_size=None):
     """Links the detections of successive scans into tracks, as ``granmem link``.
 
     ``detections``: a list of DataFrames, one per scan in order (e.g. from ``locate``), or
@@ -128,7 +130,8 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
     frame, particle (the track), time, x, y, z, radius, and ax, ay, az, hole_contact where
     the scans have axes. ``container`` ("xmin,ymin,zmin,xmax,ymax,zmax cm") or
     ``container_size`` ("LX,LY,LZ cm", placed at the packing's extent in the first scan)
-    moves the positions into the container's frame."""
+    moves the positions into the container's frame. ``collective_motion=False``: no
+    estimate of the packing's drift and deformation between scans (``--no-collective-motion``)."""
     scans, parts = _scans(detections)
     if length_unit is None:
         length_unit = parts[0].attrs.get("length_unit", "voxel") if parts else "voxel"
@@ -136,7 +139,7 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
         voxel_size = parts[0].attrs.get("voxel_size")
     columns, units, summary = _granmem.link(
         scans, length_unit, _vector3(voxel_size), _length(max_displacement) if
-        max_displacement != "auto" else "auto", int(memory), bool(drift), container,
+        max_displacement != "auto" else "auto", int(memory), bool(collective_motion), container,
         container_size)
     return _frame(columns, units, length_unit=length_unit, summary=summary)
 

@@ -206,33 +206,6 @@ LocateOptions locate_options(const Stack& stack, const std::string& diameter,
   return o;
 }
 
-py::tuple locate_py(const py::array& array, const std::string& diameter,
-                    const std::optional<Vector3>& voxel_size, const std::string& unit,
-                    std::int64_t frame, const std::string& polarity, double hole_fraction,
-                    const std::string& beam, const std::string& axis, int passes,
-                    bool illumination) {
-  Stack stack = stack_of(array, voxel_size, unit);  // a copy: the caller's array stays as it is
-  const LocateOptions o =
-      locate_options(stack, diameter, polarity, hole_fraction, beam, axis, passes, illumination);
-  LocateSummary sum;
-  Detections d;
-  {
-    py::gil_scoped_release release;
-    d = locate(std::move(stack), o, &sum);
-  }
-  d.frame = frame;
-  py::dict summary;
-  summary["candidates"] = sum.candidates;
-  summary["located"] = sum.located;
-  summary["rejected"] = sum.rejected;
-  summary["on_edge"] = sum.on_edge;
-  summary["seconds"] = sum.seconds;
-  summary["length_unit"] = d.length_unit;
-  summary["voxel_size"] = optional_vector(d.voxel_size);
-  const Table t = to_table(d);
-  return py::make_tuple(columns_of(t), units_of(t), summary);
-}
-
 // ------------------------------------------------------------------------------ render
 
 std::vector<RenderedGrain> grains_of(const py::dict& columns, const std::string& length_unit) {
@@ -609,6 +582,40 @@ auto run_interruptible(Job job, ReportQueue& queue, std::atomic<bool>& stop,
   return result;
 }
 
+// ---------------------------------- locate on its own thread: its stages as progress, Ctrl-C
+
+py::tuple locate_py(const py::array& array, const std::string& diameter,
+                    const std::optional<Vector3>& voxel_size, const std::string& unit,
+                    std::int64_t frame, const std::string& polarity, double hole_fraction,
+                    const std::string& beam, const std::string& axis, int passes, bool illumination,
+                    const py::object& progress) {
+  Stack stack = stack_of(array, voxel_size, unit);  // a copy: the caller's array stays as it is
+  LocateOptions o =
+      locate_options(stack, diameter, polarity, hole_fraction, beam, axis, passes, illumination);
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  o.log = [&](const std::string& line) { queue.push(Report{line, {}}); };
+  o.stop = &stop;
+  LocateSummary sum;
+  const Detections d = run_interruptible(
+      [&] {
+        Detections found = locate(std::move(stack), o, &sum);
+        found.frame = frame;
+        return found;
+      },
+      queue, stop, progress);
+  py::dict summary;
+  summary["candidates"] = sum.candidates;
+  summary["located"] = sum.located;
+  summary["rejected"] = sum.rejected;
+  summary["on_edge"] = sum.on_edge;
+  summary["seconds"] = sum.seconds;
+  summary["length_unit"] = d.length_unit;
+  summary["voxel_size"] = optional_vector(d.voxel_size);
+  const Table t = to_table(d);
+  return py::make_tuple(columns_of(t), units_of(t), summary);
+}
+
 std::string setting_text(const py::handle& value) {
   if (py::isinstance<py::bool_>(value)) return value.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::str>(value)) return value.cast<std::string>();
@@ -843,7 +850,7 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("voxel_size") = py::none(), py::arg("unit") = "", py::arg("frame") = 0,
         py::arg("polarity") = "dark", py::arg("hole_fraction") = LocateOptions{}.hole_fraction,
         py::arg("beam") = "x", py::arg("axis") = "fit", py::arg("passes") = LocateOptions{}.passes,
-        py::arg("illumination") = true);
+        py::arg("illumination") = true, py::arg("progress") = py::none());
   m.def("render", &render_py, py::arg("grains"), py::arg("length_unit"),
         py::arg("diameter_px") = RenderOptions{}.diameter_px,
         py::arg("slice_spacing_ratio") = RenderOptions{}.slice_spacing_ratio,

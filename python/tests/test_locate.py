@@ -52,6 +52,20 @@ def test_locate_leaves_the_callers_stack_as_it_was():
     np.testing.assert_array_equal(stack, before)
 
 
+def test_locate_reports_its_stages_and_stops_on_ctrl_c():
+    stack, voxel, _ = render(lattice())
+    stages = []
+    granmem.locate(stack, diameter=DIAMETER_PX, progress=lambda r: stages.append(r["line"]))
+    assert stages[:2] == ["illumination", "candidates"]
+    assert stages[2].startswith("fits: the first pass over") and stages[-1] == "hole axes"
+
+    def stop_at_the_fits(report):
+        if report["line"].startswith("fits"):
+            raise KeyboardInterrupt  # as Ctrl-C would, between two stages
+    with pytest.raises(KeyboardInterrupt):
+        granmem.locate(stack, diameter=DIAMETER_PX, progress=stop_at_the_fits)
+
+
 def test_locate_in_python_equals_the_command_line(tmp_path, cli):
     stack, voxel, _ = render(lattice())
     granmem.write_tiff(stack, tmp_path / "scan.tif", voxel_size=voxel, unit="mm")

@@ -386,3 +386,47 @@ TEST(Locate, DiameterLargerThanTheStackIsAnError) {
 
 }  // namespace
 }  // namespace granmem
+
+namespace granmem {
+namespace {
+
+// locate says each stage as it begins and stops between two when asked (Python's Ctrl-C, a
+// signal handler): an Error, nothing returned.
+TEST(LocateStages, EachStageIsSaidAndAStopEndsLocateBeforeTheNext) {
+  const testing::PackingScan p = testing::packing_scan(30, 0.5, 10, 1, 5);
+  const Stack stack = render_scan(p.grains, p.options, nullptr);
+  LocateOptions o;
+  o.diameter = 10;
+  std::vector<std::string> said;
+  o.log = [&](const std::string& line) { said.push_back(line); };
+  locate(stack, o);
+  ASSERT_GE(said.size(), 5u);
+  EXPECT_EQ(said[0], "illumination");
+  EXPECT_EQ(said[1], "candidates");
+  EXPECT_EQ(said[2].rfind("fits: the first pass over ", 0), 0u) << said[2];
+  EXPECT_EQ(said[3].rfind("fits: round 2 of up to ", 0), 0u) << said[3];
+  EXPECT_EQ(said.back(), "hole axes");
+
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  said.clear();
+  o.log = [&](const std::string& line) {
+    said.push_back(line);
+    if (line.rfind("fits: round 2", 0) == 0) stop = true;
+  };
+  try {
+    locate(stack, o);
+    ADD_FAILURE() << "not stopped";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("locate: stopped before fits: round 3", 0), 0u)
+        << e.what();
+  }
+  EXPECT_EQ(said.size(), 4u);
+  stop = true;
+  said.clear();
+  EXPECT_THROW(locate(stack, o), Error);
+  EXPECT_TRUE(said.empty());  // stopped before the first stage
+}
+
+}  // namespace
+}  // namespace granmem

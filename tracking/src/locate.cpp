@@ -141,6 +141,13 @@ namespace {
 // The grains of one normalised scan being located, stage by stage: candidates, model fits
 // pass after pass with searches for missed grains between them, the holes' axes, and the
 // detections. Lengths physical (voxels where the scan has no voxel size).
+// Between two stages: stops if asked (an Error the caller sees as the interruption), else
+// says what comes next.
+void begin_stage(const LocateOptions& o, const std::string& what) {
+  if (o.stop && o.stop->load()) throw Error("locate: stopped before " + what);
+  if (o.log) o.log(what);
+}
+
 class GrainLocator {
  public:
   GrainLocator(const Stack& stack, const LocateOptions& o)
@@ -156,6 +163,9 @@ class GrainLocator {
   // The candidates of the scan (maxima of the smoothed grain fraction).
   void find() { add_candidates(find_candidates(stack_, candidate_options_)); }
 
+  // The next stage begins: said, unless the caller has asked to stop.
+  void stage(const std::string& what) const { begin_stage(o_, what); }
+
   // A first fit of every candidate with its neighbours' voxels left out, then, with the
   // neighbours in the model, pass after pass; before each, grains the candidates missed
   // (a maximum merged with a neighbour's, a fit drawn onto a neighbour) are looked for in
@@ -163,10 +173,13 @@ class GrainLocator {
   // grain. Each fit reads its neighbours as the last pass left them: `passes` refit every
   // grain; further searches only the new grains and their neighbours.
   void fit() {
+    stage("fits: the first pass over " + std::to_string(grains_.size()) + " candidates");
     fit_pass(false, [](std::size_t) { return true; });
     select();
     const int rounds = std::max(o_.passes - 1, o_.search_rounds);
     for (int round = 0; round < rounds; ++round) {
+      stage("fits: round " + std::to_string(round + 2) + " of up to " + std::to_string(rounds + 1) +
+            ", " + std::to_string(grains_.size()) + " grains");
       const std::vector<Eigen::Vector3d> hidden =
           round < o_.search_rounds ? search_unexplained() : std::vector<Eigen::Vector3d>{};
       const bool refit_all = round < o_.passes - 1;
@@ -537,12 +550,15 @@ Detections locate(Stack stack, const LocateOptions& o, LocateSummary* summary) {
     return s;
   };
   LocateSummary sum;
+  begin_stage(o, "illumination");
   normalize(stack, o);
   sum.seconds_illumination = lap();
   GrainLocator locator(stack, o);
+  begin_stage(o, "candidates");
   locator.find();
   sum.seconds_candidates = lap();
   locator.fit();
+  begin_stage(o, "hole axes");
   locator.refit_axes();
   sum.seconds_fits = lap();
   Detections d = locator.detections(sum);

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <atomic>
 #include <cstddef>
+#include <functional>
 #include <string>
 
 #include "granmem/tracking/detections.hpp"
@@ -28,6 +30,12 @@ struct LocateOptions {
   // Searches of what the found grains leave unexplained, for grains the candidates missed;
   // each is followed by a pass over the new grains and their neighbours.
   int search_rounds = 4;
+
+  // What locate is doing, a line per stage (illumination, candidates, each pass of fits,
+  // the axes), and a flag (a signal handler's, Python's Ctrl-C) that stops it between two
+  // stages with Error "locate: stopped ...".
+  std::function<void(const std::string&)> log;
+  const std::atomic<bool>* stop = nullptr;
 
   // Throws Error naming the first option out of its range (locate() calls it first).
   void validate() const;

@@ -106,6 +106,254 @@ struct Output {
   std::vector<std::size_t> grains;
 };
 
+// The store indices of the tracked grains' ids.
+std::vector<std::size_t> tracked_indices(const Grains& g, const std::vector<std::int64_t>& ids) {
+  std::unordered_map<std::int64_t, std::size_t> index;
+  for (std::size_t i = 0; i < g.size(); ++i)
+    index[g.id[i]] = i;
+  std::vector<std::size_t> tracked;
+  for (std::int64_t id : ids) {
+    const auto it = index.find(id);
+    if (it == index.end()) throw Error("tracked grain " + std::to_string(id) + ": no such grain");
+    tracked.push_back(it->second);
+  }
+  return tracked;
+}
+
+// One call of run_cycles, stage by stage: the outputs opened (new, or continued after the
+// frames a checkpoint counted), the cycles stepped with the wall following the drive, the
+// frames, observables, kept states and checkpoints written as they fall due.
+class CycleRunner {
+ public:
+  CycleRunner(Simulation& sim, const CyclicOptions& o, ProtocolState& state,
+              const std::function<void(const CyclicProgress&)>& progress,
+              const std::atomic<bool>* stop)
+      : sim_(sim),
+        o_(o),
+        state_(state),
+        progress_(progress),
+        stop_(stop),
+        steps_per_cycle_(std::llround(o.drive.period / sim.physics().dt)),
+        full_step_(std::llround(o.drive.full_compression_time() / o.drive.period *
+                                double(steps_per_cycle_))),
+        tracked_(tracked_indices(sim.grains(), o.tracked_grains)),
+        samples_(tracked_.empty() ? 0 : o.samples_per_cycle) {}
+
+  CyclicSummary run() {
+    open_outputs();
+    if (fresh_) start_fresh();
+    clock_start_ = last_report_ = std::chrono::steady_clock::now();
+    steps_total_ = (o_.cycles - state_.cycles_done) * steps_per_cycle_ - state_.step_in_cycle;
+    // The wall follows the drive by step count, so that a resumed run moves it identically;
+    // step k of n is at k/n of the period, so that a cycle ends exactly where it began. The
+    // motion refers to this object: it is removed however run() ends.
+    sim_.set_wall_motion([this](double) {
+      return o_.drive.at(o_.drive.period * double(sim_.step_count() - cycle_start_) /
+                         double(steps_per_cycle_));
+    });
+    struct ClearWallMotion {
+      Simulation& sim;
+      ~ClearWallMotion() { sim.set_wall_motion({}); }
+    } clear_wall_motion{sim_};
+    while (state_.cycles_done < o_.cycles) {
+      if (!run_cycle()) {
+        save(false);
+        summary_.interrupted = true;
+        summary_.cycles_done = state_.cycles_done;
+        return summary_;
+      }
+      end_cycle();
+    }
+    save(true);
+    return finished();
+  }
+
+ private:
+  // In-cycle samples at the steps where step * samples / steps_per_cycle moves on: exactly
+  // samples_per_cycle of them, evenly spread, the last at the end of the cycle.
+  bool sample_due(std::int64_t step) const {
+    return samples_ > 0 &&
+           (step * samples_) / steps_per_cycle_ != ((step - 1) * samples_) / steps_per_cycle_;
+  }
+
+  void open_outputs() {
+    std::vector<std::size_t> all(sim_.grains().size());
+    for (std::size_t i = 0; i < all.size(); ++i)
+      all[i] = i;
+    fresh_ = state_.frames_written.empty();
+    open(kEnd, o_.out, all);
+    if (o_.full_compression_frames) open(kFull, full_compression_path(o_.out), all);
+    if (samples_ > 0) open(kInCycle, in_cycle_path(o_.out), tracked_);
+    observables_ = outputs_[kEnd].writer->observables();
+  }
+
+  void open(const char* kind, const std::filesystem::path& path,
+            const std::vector<std::size_t>& grains) {
+    Output& out = outputs_[kind];
+    out.grains = grains;
+    if (fresh_) {
+      out.header = header_for(sim_, grains, kind, o_.parameters);
+      out.writer = std::make_unique<TrajectoryWriter>(path, out.header);
+      state_.frames_written[kind] = 0;
+      return;
+    }
+    const auto it = state_.frames_written.find(kind);
+    if (it == state_.frames_written.end()) {
+      throw Error(std::string("resume: the checkpoint's run wrote no ") + kind + " frames");
+    }
+    out.writer =
+        std::make_unique<TrajectoryWriter>(TrajectoryWriter::resume(path, std::size_t(it->second)));
+    out.writer->set_parameters(o_.parameters);  // a resumed run may have more cycles
+    out.header = out.writer->header();
+  }
+
+  // The prepared packing, before the first cycle: frame 0, its observables, and the state
+  // kept if cycle 0 is asked for (the untrained packing, the read-out's reference).
+  void start_fresh() {
+    state_.cycles_done = 0;
+    state_.step_in_cycle = 0;
+    append(kEnd, 0);
+    end_of_cycle_observables(driven_wall_force(sim_));
+    keep_if_asked();
+  }
+
+  void record(const char* name, const char* unit, double value) {
+    Observable& obs = observables_[name];
+    obs.unit = unit;
+    obs.value.push_back(value);
+    obs.step.push_back(state_.cycles_done);
+    obs.time.push_back(sim_.time());
+  }
+
+  void append(const char* kind, std::int64_t step) {
+    Output& out = outputs_.at(kind);
+    out.writer->append(frame_of(sim_, out.header, out.grains, step));
+    ++state_.frames_written[kind];
+  }
+
+  void end_of_cycle_observables(double full_compression_force) {
+    const Grains& g = sim_.grains();
+    record("wall_force", "N", driven_wall_force(sim_));
+    record("wall_force_full_compression", "N", full_compression_force);
+    record("lid_height", "m", packing_height(sim_));
+    record("packing_fraction", "1", packing_fraction(sim_));
+    record("kinetic_energy", "J", sim_.kinetic_energy());
+    record("contacts_per_grain", "1", 2.0 * double(sim_.contact_count()) / double(g.size()));
+  }
+
+  // The outputs so far (published, or committed at the end) and the checkpoint.
+  void save(bool final) {
+    for (auto& [kind, out] : outputs_) {
+      if (kind == kEnd) {
+        for (auto& [name, obs] : observables_)
+          out.writer->set_observable(name, obs);
+      }
+      if (final)
+        out.writer->commit();
+      else
+        out.writer->publish();
+    }
+    if (!o_.checkpoint.empty()) write_checkpoint(o_.checkpoint, sim_, state_);
+  }
+
+  // The state after the cycles just completed, if asked for (with the outputs so far).
+  bool keep_if_asked() {
+    const auto& keep = o_.keep_states;
+    if (std::find(keep.begin(), keep.end(), state_.cycles_done) == keep.end()) return false;
+    save(false);
+    const std::filesystem::path kept = kept_state_path(o_.out, state_.cycles_done);
+    write_checkpoint(kept, sim_, state_);
+    summary_.written.push_back(kept);
+    return true;
+  }
+
+  void report(bool force) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!progress_ || (!force && now - last_report_ < std::chrono::seconds(10))) return;
+    last_report_ = now;
+    const double seconds = std::chrono::duration<double>(now - clock_start_).count();
+    CyclicProgress p;
+    p.cycle = state_.cycles_done;
+    p.cycles = o_.cycles;
+    p.particle_steps_per_second =
+        seconds > 0 ? double(steps_run_) * double(sim_.grains().size()) / seconds : 0;
+    p.seconds_left =
+        steps_run_ > 0 ? seconds * double(steps_total_ - steps_run_) / double(steps_run_) : 0;
+    progress_(p);
+  }
+
+  // The rest of the current cycle, in runs of steps up to the next step that is read (a
+  // run saves a pass per step). False if stopped before its end.
+  bool run_cycle() {
+    if (state_.step_in_cycle == 0) state_.pending.clear();
+    while (state_.step_in_cycle < steps_per_cycle_) {
+      if (stop_ && stop_->load(std::memory_order_relaxed)) return false;
+      std::int64_t next = state_.step_in_cycle + 1;
+      while (next < steps_per_cycle_ && next - state_.step_in_cycle < kStepsPerRun &&
+             next != full_step_ && !sample_due(next))
+        ++next;
+      cycle_start_ = sim_.step_count() - state_.step_in_cycle;
+      sim_.run(next - state_.step_in_cycle);
+      steps_run_ += next - state_.step_in_cycle;
+      state_.step_in_cycle = next;
+      if (state_.step_in_cycle == full_step_) {
+        state_.pending["wall_force_full_compression"] = driven_wall_force(sim_);
+        if (o_.full_compression_frames) append(kFull, state_.cycles_done + 1);
+      }
+      if (sample_due(state_.step_in_cycle)) append(kInCycle, sim_.step_count());
+      report(false);
+    }
+    return true;
+  }
+
+  // A cycle completed: its frame and observables, a kept state or a checkpoint when due.
+  void end_cycle() {
+    ++state_.cycles_done;
+    state_.step_in_cycle = 0;
+    check_finite(sim_, state_.cycles_done);
+    append(kEnd, state_.cycles_done);
+    const auto pending = state_.pending.find("wall_force_full_compression");
+    end_of_cycle_observables(pending != state_.pending.end() ? pending->second : std::nan(""));
+    report(true);
+    if (!keep_if_asked() && o_.checkpoint_every > 0 &&
+        state_.cycles_done % o_.checkpoint_every == 0 && state_.cycles_done < o_.cycles) {
+      save(false);
+    }
+  }
+
+  CyclicSummary finished() {
+    summary_.cycles_done = state_.cycles_done;
+    summary_.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start_).count();
+    summary_.particle_steps_per_second =
+        summary_.wall_seconds > 0
+            ? double(steps_run_) * double(sim_.grains().size()) / summary_.wall_seconds
+            : 0;
+    for (auto& [kind, out] : outputs_) {
+      summary_.written.push_back(kind == kEnd    ? o_.out
+                                 : kind == kFull ? full_compression_path(o_.out)
+                                                 : in_cycle_path(o_.out));
+    }
+    return summary_;
+  }
+
+  Simulation& sim_;
+  const CyclicOptions& o_;
+  ProtocolState& state_;
+  const std::function<void(const CyclicProgress&)>& progress_;
+  const std::atomic<bool>* stop_;
+  const std::int64_t steps_per_cycle_, full_step_;
+  const std::vector<std::size_t> tracked_;
+  const std::int64_t samples_;
+  bool fresh_ = true;
+  std::map<std::string, Output> outputs_;
+  std::map<std::string, Observable> observables_;
+  CyclicSummary summary_;
+  std::chrono::steady_clock::time_point clock_start_, last_report_;
+  std::int64_t steps_run_ = 0, steps_total_ = 0;
+  std::int64_t cycle_start_ = 0;  // the simulation's step count where this cycle began
+};
+
 }  // namespace
 
 void CyclicOptions::validate(double box_y, double dt) const {
@@ -130,197 +378,8 @@ void CyclicOptions::validate(double box_y, double dt) const {
 CyclicSummary run_cycles(Simulation& sim, const CyclicOptions& o, ProtocolState& state,
                          const std::function<void(const CyclicProgress&)>& progress,
                          const std::atomic<bool>* stop) {
-  const double dt = sim.physics().dt;
-  const WallDrive& drive = o.drive;
-  o.validate(sim.container().size.y(), dt);
-  const auto steps_per_cycle = std::llround(drive.period / dt);
-  const auto full_step =
-      std::llround(drive.full_compression_time() / drive.period * double(steps_per_cycle));
-  const Grains& g = sim.grains();
-  std::vector<std::size_t> all(g.size()), tracked;
-  for (std::size_t i = 0; i < g.size(); ++i)
-    all[i] = i;
-  {
-    std::unordered_map<std::int64_t, std::size_t> index;
-    for (std::size_t i = 0; i < g.size(); ++i)
-      index[g.id[i]] = i;
-    for (std::int64_t id : o.tracked_grains) {
-      const auto it = index.find(id);
-      if (it == index.end()) throw Error("tracked grain " + std::to_string(id) + ": no such grain");
-      tracked.push_back(it->second);
-    }
-  }
-
-  // In-cycle samples at the steps where step * samples / steps_per_cycle moves on: exactly
-  // samples_per_cycle of them, evenly spread, the last at the end of the cycle.
-  const std::int64_t samples = tracked.empty() ? 0 : o.samples_per_cycle;
-  auto sample_due = [&](std::int64_t step) {
-    return samples > 0 &&
-           (step * samples) / steps_per_cycle != ((step - 1) * samples) / steps_per_cycle;
-  };
-
-  // Outputs: new, or continued after the frames a checkpoint counted.
-  const bool fresh = state.frames_written.empty();
-  std::map<std::string, Output> outputs;
-  auto open = [&](const char* kind, const std::filesystem::path& path,
-                  const std::vector<std::size_t>& grains) {
-    Output& out = outputs[kind];
-    out.grains = grains;
-    if (fresh) {
-      out.header = header_for(sim, grains, kind, o.parameters);
-      out.writer = std::make_unique<TrajectoryWriter>(path, out.header);
-      state.frames_written[kind] = 0;
-    } else {
-      const auto it = state.frames_written.find(kind);
-      if (it == state.frames_written.end()) {
-        throw Error(std::string("resume: the checkpoint's run wrote no ") + kind + " frames");
-      }
-      out.writer = std::make_unique<TrajectoryWriter>(
-          TrajectoryWriter::resume(path, std::size_t(it->second)));
-      out.writer->set_parameters(o.parameters);  // a resumed run may have more cycles
-      out.header = out.writer->header();
-    }
-  };
-  open(kEnd, o.out, all);
-  if (o.full_compression_frames) open(kFull, full_compression_path(o.out), all);
-  if (samples > 0) open(kInCycle, in_cycle_path(o.out), tracked);
-  std::map<std::string, Observable> observables = outputs[kEnd].writer->observables();
-
-  auto record = [&](const char* name, const char* unit, double value) {
-    Observable& obs = observables[name];
-    obs.unit = unit;
-    obs.value.push_back(value);
-    obs.step.push_back(state.cycles_done);
-    obs.time.push_back(sim.time());
-  };
-  auto append = [&](const char* kind, std::int64_t step) {
-    Output& out = outputs.at(kind);
-    out.writer->append(frame_of(sim, out.header, out.grains, step));
-    ++state.frames_written[kind];
-  };
-  auto end_of_cycle_observables = [&](double full_compression_force) {
-    record("wall_force", "N", driven_wall_force(sim));
-    record("wall_force_full_compression", "N", full_compression_force);
-    record("lid_height", "m", packing_height(sim));
-    record("packing_fraction", "1", packing_fraction(sim));
-    record("kinetic_energy", "J", sim.kinetic_energy());
-    record("contacts_per_grain", "1", 2.0 * double(sim.contact_count()) / double(g.size()));
-  };
-  CyclicSummary summary;
-  auto save = [&](bool final) {
-    for (auto& [kind, out] : outputs) {
-      if (kind == kEnd) {
-        for (auto& [name, obs] : observables)
-          out.writer->set_observable(name, obs);
-      }
-      if (final)
-        out.writer->commit();
-      else
-        out.writer->publish();
-    }
-    if (!o.checkpoint.empty()) write_checkpoint(o.checkpoint, sim, state);
-  };
-
-  // The state after the cycles just completed, if asked for (with the outputs so far).
-  auto keep_if_asked = [&] {
-    const auto& keep = o.keep_states;
-    if (std::find(keep.begin(), keep.end(), state.cycles_done) == keep.end()) return false;
-    save(false);
-    const std::filesystem::path kept = kept_state_path(o.out, state.cycles_done);
-    write_checkpoint(kept, sim, state);
-    summary.written.push_back(kept);
-    return true;
-  };
-
-  if (fresh) {
-    state.cycles_done = 0;
-    state.step_in_cycle = 0;
-    append(kEnd, 0);  // the prepared packing, before the first cycle
-    end_of_cycle_observables(driven_wall_force(sim));
-    keep_if_asked();  // 0: the untrained packing, the read-out's reference
-  }
-
-  const auto clock_start = std::chrono::steady_clock::now();
-  auto last_report = clock_start;
-  std::int64_t steps_run = 0;
-  const std::int64_t steps_total =
-      (o.cycles - state.cycles_done) * steps_per_cycle - state.step_in_cycle;
-  auto report = [&](bool force) {
-    const auto now = std::chrono::steady_clock::now();
-    if (!progress || (!force && now - last_report < std::chrono::seconds(10))) return;
-    last_report = now;
-    const double seconds = std::chrono::duration<double>(now - clock_start).count();
-    CyclicProgress p;
-    p.cycle = state.cycles_done;
-    p.cycles = o.cycles;
-    p.particle_steps_per_second = seconds > 0 ? double(steps_run) * double(g.size()) / seconds : 0;
-    p.seconds_left =
-        steps_run > 0 ? seconds * double(steps_total - steps_run) / double(steps_run) : 0;
-    progress(p);
-  };
-
-  // The wall follows the drive by step count, so that a resumed run moves it identically;
-  // step k of n is at k/n of the period, so that a cycle ends exactly where it began. The
-  // motion refers to this function's locals: it is removed however the function ends.
-  std::int64_t cycle_start = 0;  // the simulation's step count where this cycle began
-  sim.set_wall_motion([&](double) {
-    return drive.at(drive.period * double(sim.step_count() - cycle_start) /
-                    double(steps_per_cycle));
-  });
-  struct ClearWallMotion {
-    Simulation& sim;
-    ~ClearWallMotion() { sim.set_wall_motion({}); }
-  } clear_wall_motion{sim};
-
-  while (state.cycles_done < o.cycles) {
-    if (state.step_in_cycle == 0) state.pending.clear();
-    while (state.step_in_cycle < steps_per_cycle) {
-      if (stop && stop->load(std::memory_order_relaxed)) {
-        save(false);
-        summary.interrupted = true;
-        summary.cycles_done = state.cycles_done;
-        return summary;
-      }
-      // Steps in one run up to the next that is read (a run saves a pass per step).
-      std::int64_t next = state.step_in_cycle + 1;
-      while (next < steps_per_cycle && next - state.step_in_cycle < kStepsPerRun &&
-             next != full_step && !sample_due(next))
-        ++next;
-      cycle_start = sim.step_count() - state.step_in_cycle;
-      sim.run(next - state.step_in_cycle);
-      steps_run += next - state.step_in_cycle;
-      state.step_in_cycle = next;
-      if (state.step_in_cycle == full_step) {
-        state.pending["wall_force_full_compression"] = driven_wall_force(sim);
-        if (o.full_compression_frames) append(kFull, state.cycles_done + 1);
-      }
-      if (sample_due(state.step_in_cycle)) append(kInCycle, sim.step_count());
-      report(false);
-    }
-    ++state.cycles_done;
-    state.step_in_cycle = 0;
-    check_finite(sim, state.cycles_done);
-    append(kEnd, state.cycles_done);
-    const auto pending = state.pending.find("wall_force_full_compression");
-    end_of_cycle_observables(pending != state.pending.end() ? pending->second : std::nan(""));
-    report(true);
-    if (!keep_if_asked() && o.checkpoint_every > 0 && state.cycles_done % o.checkpoint_every == 0 &&
-        state.cycles_done < o.cycles) {
-      save(false);
-    }
-  }
-  save(true);
-  summary.cycles_done = state.cycles_done;
-  summary.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
-  summary.particle_steps_per_second =
-      summary.wall_seconds > 0 ? double(steps_run) * double(g.size()) / summary.wall_seconds : 0;
-  for (auto& [kind, out] : outputs) {
-    summary.written.push_back(kind == kEnd    ? o.out
-                              : kind == kFull ? full_compression_path(o.out)
-                                              : in_cycle_path(o.out));
-  }
-  return summary;
+  o.validate(sim.container().size.y(), sim.physics().dt);
+  return CycleRunner(sim, o, state, progress, stop).run();
 }
 
 }  // namespace granmem

@@ -273,8 +273,8 @@ void TrajectoryWriter::publish() {
                              std::filesystem::copy_options::overwrite_existing, ec);
   if (ec) throw Error(w.out.target().string() + ": cannot publish: " + ec.message());
   AtomicFile sidecar = write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
+  sidecar.commit();  // before the store: a store in place always has its sidecar
   copy.commit();
-  sidecar.commit();
 }
 
 void TrajectoryWriter::commit() {
@@ -286,10 +286,13 @@ void TrajectoryWriter::commit() {
   w.orientation = {};
   w.hole_contact = {};
   w.file.close();
-  // Sidecar first: if it cannot be written, an existing run of this name stays as it was.
+  // Sidecar first: if it cannot be written, an existing run of this name stays as it was;
+  // and it is renamed into place first, so that a store in place (what a later call reads
+  // to reuse a finished run) always has its sidecar, even if the process is killed
+  // between the two renames (the sidecar's temporary is then not left behind either).
   AtomicFile sidecar = write_xdmf(w.out.target(), kGrains, w.header, w.steps, w.times);
-  w.out.commit();
   sidecar.commit();
+  w.out.commit();
 }
 
 TrajectoryWriter TrajectoryWriter::resume(const std::filesystem::path& path,

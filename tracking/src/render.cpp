@@ -319,20 +319,34 @@ Table render_truth(const std::vector<RenderedGrain>& grains, const ScanGeometry&
   return t;
 }
 
-Stack render_scan(const std::vector<RenderedGrain>& grains, const RenderOptions& options,
-                  Table* truth) {
+namespace {
+
+// The blur kernels (x, y: the camera; z: the sheet's thickness) and the slices' padding,
+// which is their reach.
+struct Blur {
+  std::vector<double> kx, ky, kz;
+  explicit Blur(const Eigen::Vector3d& sigma)
+      : kx(gaussian_kernel(sigma.x())),
+        ky(gaussian_kernel(sigma.y())),
+        kz(gaussian_kernel(sigma.z())) {}
+};
+
+Layout layout_of(const std::vector<RenderedGrain>& grains, const RenderOptions& options,
+                 const Blur& blur) {
   Layout layout;
   layout.geometry = scan_geometry(grains, options);
-  const ScanGeometry& g = layout.geometry;
-  const std::vector<double> kx = gaussian_kernel(options.blur_sigma.x());
-  const std::vector<double> ky = gaussian_kernel(options.blur_sigma.y());
-  const std::vector<double> kz = gaussian_kernel(options.blur_sigma.z());
-  layout.px = std::int64_t(kx.size() / 2);
-  layout.py = std::int64_t(ky.size() / 2);
-  layout.pz = std::int64_t(kz.size() / 2);
-  layout.nxp = g.nx + 2 * layout.px;
-  layout.nyp = g.ny + 2 * layout.py;
+  layout.px = std::int64_t(blur.kx.size() / 2);
+  layout.py = std::int64_t(blur.ky.size() / 2);
+  layout.pz = std::int64_t(blur.kz.size() / 2);
+  layout.nxp = layout.geometry.nx + 2 * layout.px;
+  layout.nyp = layout.geometry.ny + 2 * layout.py;
+  return layout;
+}
 
+// Each grain's shape (its hole where the grains are dark and have an axis) and how finely
+// its cells are refined.
+std::vector<Drawable> drawables_of(const std::vector<RenderedGrain>& grains,
+                                   const RenderOptions& options, const ScanGeometry& g) {
   std::vector<Drawable> drawables;
   for (const RenderedGrain& grain : grains) {
     Drawable d;
@@ -346,145 +360,231 @@ Stack render_scan(const std::vector<RenderedGrain>& grains, const RenderOptions&
     d.levels = refinement_levels(d.shape, g.voxel_size, options.edge_tolerance);
     drawables.push_back(d);
   }
-  // The grains crossing each layer of cells: layer L lies between padded slices L and
-  // L + 1, for L = -pz - 1 .. nz + pz - 1.
-  const std::int64_t layer_first = -layout.pz - 1, layer_last = g.nz + layout.pz - 1;
-  std::vector<std::vector<std::int32_t>> in_layer(
-      static_cast<std::size_t>(layer_last - layer_first + 1));
+  return drawables;
+}
+
+// The grains crossing each layer of cells: layer L lies between padded slices L and L + 1,
+// for L = first() .. nz + pz - 1.
+struct LayerIndex {
+  std::int64_t first = 0;
+  std::vector<std::vector<std::int32_t>> grains;
+  const std::vector<std::int32_t>& at(std::int64_t layer) const {
+    return grains[std::size_t(layer - first)];
+  }
+};
+
+LayerIndex grains_by_layer(const std::vector<Drawable>& drawables, const Layout& layout) {
+  const ScanGeometry& g = layout.geometry;
+  LayerIndex index;
+  index.first = -layout.pz - 1;
+  const std::int64_t last = g.nz + layout.pz - 1;
+  index.grains.resize(static_cast<std::size_t>(last - index.first + 1));
   for (std::size_t i = 0; i < drawables.size(); ++i) {
     const double c = g.to_voxels(drawables[i].shape.centre).z();
     const double r = drawables[i].shape.radius / g.voxel_size.z();
-    const std::int64_t lo = std::max<std::int64_t>(layer_first, std::floor(c - r));
-    const std::int64_t hi = std::min<std::int64_t>(layer_last, std::ceil(c + r) - 1);
+    const std::int64_t lo = std::max<std::int64_t>(index.first, std::floor(c - r));
+    const std::int64_t hi = std::min<std::int64_t>(last, std::ceil(c + r) - 1);
     for (std::int64_t L = lo; L <= hi; ++L) {
-      in_layer[L - layer_first].push_back(static_cast<std::int32_t>(i));
+      index.grains[L - index.first].push_back(static_cast<std::int32_t>(i));
     }
   }
+  return index;
+}
 
-  const double fluid = options.fluid();
-  const double grain = options.grain();
-  std::vector<double> wall_x, wall_y;
-  if (options.wall) {
-    (options.wall->axis == 0 ? wall_x : wall_y) =
-        options.wall->axis == 0 ? wall_profile(*options.wall, -layout.px, layout.nxp)
-                                : wall_profile(*options.wall, -layout.py, layout.nyp);
+// The light of every slice but its flicker and streaks (sheet_light): the levels of grain
+// and fluid, the wall seen edge-on, and the attenuation along the beam from the side where
+// it enters (at -1/2 or n - 1/2), over the padded slice.
+struct Illumination {
+  double fluid = 0, grain = 0, wall_level = 0;
+  std::vector<double> wall_x, wall_y;  // the wall's share of each column or row
+  bool beam_along_x = true;
+  std::vector<double> attenuation;  // per padded voxel along the beam
+  std::int64_t across_first = 0, across_n = 0;
+
+  Illumination(const RenderOptions& options, const Layout& layout)
+      : fluid(options.fluid()),
+        grain(options.grain()),
+        wall_level(options.wall ? options.wall->level : 0.0),
+        beam_along_x(options.beam == Beam::plus_x || options.beam == Beam::minus_x) {
+    const ScanGeometry& g = layout.geometry;
+    if (options.wall) {
+      (options.wall->axis == 0 ? wall_x : wall_y) =
+          options.wall->axis == 0 ? wall_profile(*options.wall, -layout.px, layout.nxp)
+                                  : wall_profile(*options.wall, -layout.py, layout.nyp);
+    }
+    const std::int64_t along_n = beam_along_x ? layout.nxp : layout.nyp;
+    const std::int64_t along_first = beam_along_x ? -layout.px : -layout.py;
+    const std::int64_t along_count = beam_along_x ? g.nx : g.ny;
+    attenuation.resize(static_cast<std::size_t>(along_n));
+    for (std::int64_t k = 0; k < along_n; ++k) {
+      const double i = double(along_first + k);
+      const bool forward = options.beam == Beam::plus_x || options.beam == Beam::plus_y;
+      const double travelled = forward ? i + 0.5 : double(along_count) - 0.5 - i;
+      attenuation[k] = std::exp(-options.attenuation * travelled);
+    }
+    across_n = beam_along_x ? layout.nyp : layout.nxp;
+    across_first = beam_along_x ? -layout.py : -layout.px;
   }
-  const double wall_level = options.wall ? options.wall->level : 0.0;
-  const bool beam_along_x = options.beam == Beam::plus_x || options.beam == Beam::minus_x;
-  // Attenuation along the beam, from the side where it enters (at -1/2 or n - 1/2).
-  const std::int64_t along_n = beam_along_x ? layout.nxp : layout.nyp;
-  const std::int64_t along_first = beam_along_x ? -layout.px : -layout.py;
-  const std::int64_t along_count = beam_along_x ? g.nx : g.ny;
-  std::vector<double> attenuation(static_cast<std::size_t>(along_n));
-  for (std::int64_t k = 0; k < along_n; ++k) {
-    const double i = double(along_first + k);
-    const bool forward = options.beam == Beam::plus_x || options.beam == Beam::plus_y;
-    const double travelled = forward ? i + 0.5 : double(along_count) - 0.5 - i;
-    attenuation[k] = std::exp(-options.attenuation * travelled);
-  }
-  const std::int64_t across_n = beam_along_x ? layout.nyp : layout.nxp;
-  const std::int64_t across_first = beam_along_x ? -layout.py : -layout.px;
+};
 
-  Stack stack(g.nx, g.ny, g.nz, options.bits);
-  stack.voxel_size = g.voxel_size;
-  stack.unit = options.length_unit;
-  stack.source = "rendered scan (seed " + std::to_string(options.seed) + ")";
-  const double full_scale = stack.max_value();
-
+// Slices per block of the grain fraction held at once (with its halo of pz slices each side).
+std::int64_t slices_per_block(const RenderOptions& options, const Layout& layout) {
   std::int64_t block = options.slices_per_block;
   if (block == 0) {
     const double fit = kBlockBytes / (double(layout.slice_voxels()) * sizeof(float));
     block = std::max<std::int64_t>(1, std::int64_t(fit) - 2 * layout.pz);
   }
-  block = std::min(block, g.nz);
-  const std::size_t plane = layout.slice_voxels();
-  std::vector<float> phi;  // grain fraction of the padded slices of one block, with their halo
+  return std::min(block, layout.geometry.nz);
+}
 
+// The grain fraction of the padded slices first .. first + count - 1 into `phi`: the layers
+// of cells from first - 1 to first + count - 1, even ones then odd ones; each writes two
+// slices, which no other layer of its parity touches, so each slice adds its two layers in
+// one order whatever the threads and blocks.
+void draw_block(const std::vector<Drawable>& drawables, const LayerIndex& layers,
+                const Layout& layout, std::int64_t first, std::int64_t count,
+                std::vector<float>& phi) {
+  const std::size_t plane = layout.slice_voxels();
+  phi.assign(plane * static_cast<std::size_t>(count), 0.0f);
+  const auto slice_phi = [&](std::int64_t z) -> float* {
+    return z < first || z >= first + count
+               ? nullptr
+               : phi.data() + plane * static_cast<std::size_t>(z - first);
+  };
+  for (int parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t L = first - 1; L < first + count; ++L) {
+      if (((L % 2) + 2) % 2 != parity) continue;
+      draw_layer(drawables, layers.at(L), L, layout, slice_phi(L), slice_phi(L + 1));
+    }
+  }
+}
+
+// One slice from its block's grain fraction: emitted light (fluid + (grain - fluid) phi,
+// the wall over it) gathered through the sheet's thickness (z PSF), the sheet's light, the
+// camera (x, y PSF), its noise and quantisation.
+class SliceRenderer {
+ public:
+  SliceRenderer(const RenderOptions& options, const Layout& layout, const Blur& blur,
+                const Illumination& light)
+      : o_(options), layout_(layout), blur_(blur), light_(light) {}
+
+  void render(std::int64_t z, std::int64_t z0, const std::vector<float>& phi, Stack& stack) const {
+    std::vector<double> sheet = emitted(z, z0, phi);
+    illuminate(z, sheet);
+    std::vector<double> image = camera(sheet);
+    record(z, image, stack);
+  }
+
+ private:
+  std::vector<double> emitted(std::int64_t z, std::int64_t z0,
+                              const std::vector<float>& phi) const {
+    const std::size_t plane = layout_.slice_voxels();
+    std::vector<double> sheet(plane, 0.0);
+    for (std::size_t k = 0; k < blur_.kz.size(); ++k) {
+      const float* src = phi.data() + plane * static_cast<std::size_t>(z - z0 + k);
+      for (std::int64_t y = 0; y < layout_.nyp; ++y) {
+        const float* in = src + y * layout_.nxp;
+        double* out = sheet.data() + y * layout_.nxp;
+        for (std::int64_t x = 0; x < layout_.nxp; ++x) {
+          // grain * f + fluid * (1 - f): exactly the grain's or the fluid's level at 1 or 0.
+          const double f = std::min(double(in[x]), 1.0);
+          double e = light_.grain * f + light_.fluid * (1 - f);
+          if (!light_.wall_x.empty()) e += (light_.wall_level - e) * light_.wall_x[x];
+          if (!light_.wall_y.empty()) e += (light_.wall_level - e) * light_.wall_y[y];
+          out[x] += blur_.kz[k] * e;
+        }
+      }
+    }
+    return sheet;
+  }
+
+  void illuminate(std::int64_t z, std::vector<double>& sheet) const {
+    const SheetLight light = sheet_light(o_, z, light_.across_first, light_.across_n);
+    for (std::int64_t y = 0; y < layout_.nyp; ++y) {
+      double* row = sheet.data() + y * layout_.nxp;
+      if (light_.beam_along_x) {
+        const double across = light.flicker * light.across[y];
+        for (std::int64_t x = 0; x < layout_.nxp; ++x)
+          row[x] *= across * light_.attenuation[x];
+      } else {
+        const double along = light.flicker * light_.attenuation[y];
+        for (std::int64_t x = 0; x < layout_.nxp; ++x)
+          row[x] *= along * light.across[x];
+      }
+    }
+  }
+
+  // Camera blur, x then y, onto the unpadded slice.
+  std::vector<double> camera(const std::vector<double>& sheet) const {
+    const ScanGeometry& g = layout_.geometry;
+    std::vector<double> blurred_x(static_cast<std::size_t>(layout_.nyp * g.nx));
+    for (std::int64_t y = 0; y < layout_.nyp; ++y) {
+      const double* src = sheet.data() + y * layout_.nxp;
+      double* dst = blurred_x.data() + y * g.nx;
+      for (std::int64_t x = 0; x < g.nx; ++x) {
+        double sum = 0;
+        for (std::size_t k = 0; k < blur_.kx.size(); ++k)
+          sum += blur_.kx[k] * src[x + std::int64_t(k)];
+        dst[x] = sum;
+      }
+    }
+    std::vector<double> image(static_cast<std::size_t>(g.ny * g.nx), 0.0);
+    for (std::int64_t y = 0; y < g.ny; ++y) {
+      double* dst = image.data() + y * g.nx;
+      for (std::size_t k = 0; k < blur_.ky.size(); ++k) {
+        const double* src = blurred_x.data() + (y + std::int64_t(k)) * g.nx;
+        for (std::int64_t x = 0; x < g.nx; ++x)
+          dst[x] += blur_.ky[k] * src[x];
+      }
+    }
+    return image;
+  }
+
+  // Shot noise, read noise, quantisation (to the nearest grey value, halves up).
+  void record(std::int64_t z, const std::vector<double>& image, Stack& stack) const {
+    const double full_scale = stack.max_value();
+    seeded_random::Stream random(o_.seed, kNoiseStream, static_cast<std::uint64_t>(z));
+    std::uint16_t* out = stack.slice(z);
+    for (std::size_t i = 0; i < image.size(); ++i) {
+      double s = std::max(0.0, image[i]);
+      if (o_.gain > 0) s = o_.gain * double(random.poisson(s / o_.gain));
+      if (o_.read_noise > 0) s += o_.read_noise * random.normal();
+      out[i] =
+          static_cast<std::uint16_t>(std::clamp(std::floor(s * full_scale + 0.5), 0.0, full_scale));
+    }
+  }
+
+  const RenderOptions& o_;
+  const Layout& layout_;
+  const Blur& blur_;
+  const Illumination& light_;
+};
+
+}  // namespace
+
+Stack render_scan(const std::vector<RenderedGrain>& grains, const RenderOptions& options,
+                  Table* truth) {
+  const Blur blur(options.blur_sigma);
+  const Layout layout = layout_of(grains, options, blur);
+  const ScanGeometry& g = layout.geometry;
+  const std::vector<Drawable> drawables = drawables_of(grains, options, g);
+  const LayerIndex layers = grains_by_layer(drawables, layout);
+  const Illumination light(options, layout);
+  const SliceRenderer slices(options, layout, blur, light);
+
+  Stack stack(g.nx, g.ny, g.nz, options.bits);
+  stack.voxel_size = g.voxel_size;
+  stack.unit = options.length_unit;
+  stack.source = "rendered scan (seed " + std::to_string(options.seed) + ")";
+  const std::int64_t block = slices_per_block(options, layout);
+  std::vector<float> phi;  // grain fraction of the padded slices of one block, with their halo
   for (std::int64_t z0 = 0; z0 < g.nz; z0 += block) {
     const std::int64_t z1 = std::min(g.nz, z0 + block);
-    const std::int64_t first = z0 - layout.pz, count = z1 - z0 + 2 * layout.pz;
-    phi.assign(plane * static_cast<std::size_t>(count), 0.0f);
-    const auto slice_phi = [&](std::int64_t z) -> float* {
-      return z < first || z >= first + count
-                 ? nullptr
-                 : phi.data() + plane * static_cast<std::size_t>(z - first);
-    };
-    // The layers of cells from first - 1 to first + count - 1, even ones then odd ones:
-    // each writes two slices, which no other layer of its parity touches. Each slice thus
-    // adds its two layers in one order whatever the threads and blocks.
-    for (int parity = 0; parity < 2; ++parity) {
+    draw_block(drawables, layers, layout, z0 - layout.pz, z1 - z0 + 2 * layout.pz, phi);
 #pragma omp parallel for schedule(dynamic, 1)
-      for (std::int64_t L = first - 1; L < first + count; ++L) {
-        if (((L % 2) + 2) % 2 != parity) continue;
-        draw_layer(drawables, in_layer[L - layer_first], L, layout, slice_phi(L), slice_phi(L + 1));
-      }
-    }
-
-    // Each slice: emitted light (fluid + (grain - fluid) phi, the wall over it), gathered
-    // through the sheet's thickness (z PSF); the sheet's light; the camera (x, y PSF, noise).
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t z = z0; z < z1; ++z) {
-      std::vector<double> sheet(plane, 0.0);
-      for (std::size_t k = 0; k < kz.size(); ++k) {
-        const float* src = phi.data() + plane * static_cast<std::size_t>(z - z0 + k);
-        for (std::int64_t y = 0; y < layout.nyp; ++y) {
-          const float* in = src + y * layout.nxp;
-          double* out = sheet.data() + y * layout.nxp;
-          for (std::int64_t x = 0; x < layout.nxp; ++x) {
-            // grain * f + fluid * (1 - f): exactly the grain's or the fluid's level at 1 or 0.
-            const double f = std::min(double(in[x]), 1.0);
-            double e = grain * f + fluid * (1 - f);
-            if (!wall_x.empty()) e += (wall_level - e) * wall_x[x];
-            if (!wall_y.empty()) e += (wall_level - e) * wall_y[y];
-            out[x] += kz[k] * e;
-          }
-        }
-      }
-      const SheetLight light = sheet_light(options, z, across_first, across_n);
-      for (std::int64_t y = 0; y < layout.nyp; ++y) {
-        double* row = sheet.data() + y * layout.nxp;
-        if (beam_along_x) {
-          const double across = light.flicker * light.across[y];
-          for (std::int64_t x = 0; x < layout.nxp; ++x)
-            row[x] *= across * attenuation[x];
-        } else {
-          const double along = light.flicker * attenuation[y];
-          for (std::int64_t x = 0; x < layout.nxp; ++x)
-            row[x] *= along * light.across[x];
-        }
-      }
-      // Camera blur, x then y, onto the unpadded slice.
-      std::vector<double> blurred_x(static_cast<std::size_t>(layout.nyp * g.nx));
-      for (std::int64_t y = 0; y < layout.nyp; ++y) {
-        const double* src = sheet.data() + y * layout.nxp;
-        double* dst = blurred_x.data() + y * g.nx;
-        for (std::int64_t x = 0; x < g.nx; ++x) {
-          double sum = 0;
-          for (std::size_t k = 0; k < kx.size(); ++k)
-            sum += kx[k] * src[x + std::int64_t(k)];
-          dst[x] = sum;
-        }
-      }
-      std::vector<double> image(static_cast<std::size_t>(g.ny * g.nx), 0.0);
-      for (std::int64_t y = 0; y < g.ny; ++y) {
-        double* dst = image.data() + y * g.nx;
-        for (std::size_t k = 0; k < ky.size(); ++k) {
-          const double* src = blurred_x.data() + (y + std::int64_t(k)) * g.nx;
-          for (std::int64_t x = 0; x < g.nx; ++x)
-            dst[x] += ky[k] * src[x];
-        }
-      }
-      // Shot noise, read noise, quantisation (to the nearest grey value, halves up).
-      seeded_random::Stream random(options.seed, kNoiseStream, static_cast<std::uint64_t>(z));
-      std::uint16_t* out = stack.slice(z);
-      for (std::size_t i = 0; i < image.size(); ++i) {
-        double s = std::max(0.0, image[i]);
-        if (options.gain > 0) s = options.gain * double(random.poisson(s / options.gain));
-        if (options.read_noise > 0) s += options.read_noise * random.normal();
-        out[i] = static_cast<std::uint16_t>(
-            std::clamp(std::floor(s * full_scale + 0.5), 0.0, full_scale));
-      }
-    }
+    for (std::int64_t z = z0; z < z1; ++z)
+      slices.render(z, z0, phi, stack);
   }
   if (truth) *truth = render_truth(grains, g, options.frame);
   return stack;

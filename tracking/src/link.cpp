@@ -482,9 +482,12 @@ double default_max_displacement(const std::vector<Detections>& scans) {
   return kDefaultReach * typical_diameter(scans);
 }
 
-Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions& options,
-                        LinkSummary* summary) {
-  check_scans(scans, options);
+namespace {
+
+// The largest displacement a link may have: given, or kDefaultReach grain diameters; and the
+// length scale of the motion estimates (the grains' diameter, or what the reach implies).
+std::pair<double, double> reach_and_scale(const std::vector<Detections>& scans,
+                                          const LinkOptions& options) {
   double scale = typical_diameter(scans);
   const double reach =
       options.max_displacement > 0 ? options.max_displacement : kDefaultReach * scale;
@@ -498,58 +501,124 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
           "link: no grain radius and too few grains to choose a max displacement: give one");
     }
   }
+  return {reach, scale};
+}
 
-  LinkSummary local_summary;
-  LinkSummary& sum = summary ? *summary : local_summary;
-  sum = LinkSummary{};
-  sum.max_displacement = reach;
-  sum.length_unit = scans.front().length_unit;
+// The tracks, scan by scan: every detection of the first starts one; each later scan is
+// linked to the tracks seen in the scan before and those in memory.
+class TrackBuilder {
+ public:
+  TrackBuilder(const std::vector<Detections>& scans, const LinkOptions& options, double reach,
+               double scale)
+      : scans_(scans), options_(options), reach_(reach), scale_(scale) {}
 
-  std::vector<Track> tracks;
-  std::vector<std::size_t> active;  // tracks that may still be linked
-
-  auto start_track = [&](std::size_t t, std::size_t j) {
-    Track track;
-    track.at = scans[t].position.row(Eigen::Index(j)).transpose();
-    track.last_scan = t;
-    track.seen.emplace_back(t, j);
-    active.push_back(tracks.size());
-    tracks.push_back(std::move(track));
-  };
-
-  for (std::size_t t = 0; t < scans.size(); ++t) {
-    const Detections& scan = scans[t];
+  ScanLinks first_scan() {
+    const Detections& scan = scans_.front();
     ScanLinks report;
     report.frame = scan.frame;
     report.detections = scan.size();
-    if (t == 0) {
-      for (std::size_t j = 0; j < scan.size(); ++j)
-        start_track(0, j);
-      report.started = scan.size();
-      sum.scans.push_back(std::move(report));
-      continue;
-    }
+    for (std::size_t j = 0; j < scan.size(); ++j)
+      start_track(0, j);
+    report.started = scan.size();
+    return report;
+  }
 
+  ScanLinks next_scan(std::size_t t) {
+    const Detections& scan = scans_[t];
+    ScanLinks report;
+    report.frame = scan.frame;
+    report.detections = scan.size();
     // Sources: the tracks seen in the scan before first, then those in memory; each at its
     // last position moved by the motion predicted for the scans it missed.
-    std::stable_sort(active.begin(), active.end(), [&](std::size_t a, std::size_t b) {
-      return tracks[a].last_scan > tracks[b].last_scan;
+    std::stable_sort(active_.begin(), active_.end(), [&](std::size_t a, std::size_t b) {
+      return tracks_[a].last_scan > tracks_[b].last_scan;
     });
     std::vector<Eigen::Vector3d> base;
     std::size_t fresh = 0;
-    for (std::size_t id : active) {
-      const Track& track = tracks[id];
+    for (std::size_t id : active_) {
+      const Track& track = tracks_[id];
       base.push_back(track.at);
       if (track.last_scan == t - 1) ++fresh;
     }
-    const std::vector<Eigen::Vector3d> fresh_base(base.begin(),
-                                                  base.begin() + std::ptrdiff_t(fresh));
     const PointIndex to(scan.position);
+    const PairLinker linker(base, fresh, to, reach_);
+    const Pass best = best_pass(linker, base, fresh, to);
+    record(t, base, fresh, best, report);
+    return report;
+  }
 
-    // No prediction, then the drift, the uniform deformation and the local field, each
-    // refined from the links it gives (as in iterative closest point) and kept only while it
-    // lowers the objective.
-    const PairLinker linker(base, fresh, to, reach);
+  std::size_t track_count() const { return tracks_.size(); }
+
+  // The run: one grain per track (its radius the mean of its detections'), one frame per
+  // scan.
+  Trajectories run() const {
+    Trajectories run;
+    RunHeader& h = run.header;
+    h.length_unit = scans_.front().length_unit;
+    h.time_unit = "cycle";
+    h.voxel_size = scans_.front().voxel_size;
+    for (const Detections& d : scans_)
+      h.has_axis = h.has_axis || d.has_axis;
+    h.has_hole_contact = h.has_axis;
+    h.id.resize(tracks_.size());
+    h.radius.assign(tracks_.size(), kNaN);
+    for (std::size_t k = 0; k < tracks_.size(); ++k) {
+      h.id[k] = std::int64_t(k);
+      double total = 0;
+      std::size_t n = 0;
+      for (const auto& [t, j] : tracks_[k].seen) {
+        const double r = scans_[t].radius[j];
+        if (std::isfinite(r)) {
+          total += r;
+          ++n;
+        }
+      }
+      if (n) h.radius[k] = total / double(n);
+    }
+    std::ostringstream reach_text;
+    reach_text.precision(12);
+    reach_text << reach_ << " " << h.length_unit;
+    h.parameters["link/max_displacement"] = reach_text.str();
+    h.parameters["link/memory"] = std::to_string(options_.memory);
+    h.parameters["link/drift"] = options_.estimate_drift ? "on" : "off";
+    h.parameters["link/local_field"] = options_.local_field ? "on" : "off";
+    run.frames.reserve(scans_.size());
+    for (std::size_t t = 0; t < scans_.size(); ++t) {
+      Frame frame = Frame::unknown(h);
+      frame.step = scans_[t].frame;
+      frame.time = double(scans_[t].frame);
+      run.frames.push_back(std::move(frame));
+    }
+    for (std::size_t k = 0; k < tracks_.size(); ++k) {
+      const auto g = Eigen::Index(k);
+      for (const auto& [t, j] : tracks_[k].seen) {
+        const Detections& d = scans_[t];
+        Frame& frame = run.frames[t];
+        frame.position.row(g) = d.position.row(Eigen::Index(j));
+        if (d.has_axis) {
+          frame.axis.row(g) = d.axis.row(Eigen::Index(j));
+          frame.hole_contact[k] = d.hole_contact[j];
+        }
+      }
+    }
+    return run;
+  }
+
+ private:
+  void start_track(std::size_t t, std::size_t j) {
+    Track track;
+    track.at = scans_[t].position.row(Eigen::Index(j)).transpose();
+    track.last_scan = t;
+    track.seen.emplace_back(t, j);
+    active_.push_back(tracks_.size());
+    tracks_.push_back(std::move(track));
+  }
+
+  // No prediction, then the drift, the uniform deformation and the local field, each
+  // refined from the links it gives (as in iterative closest point) and kept only while it
+  // lowers the objective.
+  Pass best_pass(const PairLinker& linker, const std::vector<Eigen::Vector3d>& base,
+                 std::size_t fresh, const PointIndex& to) const {
     Pass best = linker.run(Motion{});
     auto better = [&](Pass&& pass) {
       // A pass must lower the objective by more than rounding and dithering (refits that
@@ -558,38 +627,47 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
       best = std::move(pass);
       return true;
     };
-    if (options.estimate_drift && fresh > 0 && to.size() > 0) {
+    if (options_.estimate_drift && fresh > 0 && to.size() > 0) {
+      const std::vector<Eigen::Vector3d> fresh_base(base.begin(),
+                                                    base.begin() + std::ptrdiff_t(fresh));
       Motion mode;
-      mode.drift = estimate_drift(fresh_base, to, scale, reach);
+      mode.drift = estimate_drift(fresh_base, to, scale_, reach_);
       better(linker.run(mode));
       for (int i = 0; i < kRefits; ++i) {
         const std::optional<Motion> m = PairLinker::fit_drift(linker.confident(best));
         if (!m || !better(linker.run(*m))) break;
       }
-      for (int i = 0; options.deformation && i < kRefits; ++i) {
+      for (int i = 0; options_.deformation && i < kRefits; ++i) {
         const std::optional<Motion> m = PairLinker::fit_affine(linker.confident(best));
         if (!m || !better(linker.run(*m))) break;
       }
     }
-    if (options.local_field && base.size() > 0) {
+    if (options_.local_field && base.size() > 0) {
       std::vector<Eigen::Vector3d> predicted(base.size());
       for (std::size_t s = 0; s < base.size(); ++s)
         predicted[s] = best.motion.at(base[s]);
-      const std::vector<Eigen::Vector3d> offset = linker.local_mode(
-          predicted, 2 * std::size_t(options.neighbours), std::max(2 * reach, scale), 0.3 * scale);
+      const std::vector<Eigen::Vector3d> offset =
+          linker.local_mode(predicted, 2 * std::size_t(options_.neighbours),
+                            std::max(2 * reach_, scale_), 0.3 * scale_);
       Pass refined = linker.run(best.motion, &offset);
       refined.local_field = true;
       better(std::move(refined));
     }
-    for (int i = 0; options.local_field && i < options.refinements; ++i) {
+    for (int i = 0; options_.local_field && i < options_.refinements; ++i) {
       const std::vector<Eigen::Vector3d> offset =
-          linker.local_field(best, std::size_t(options.neighbours), 3 * scale);
+          linker.local_field(best, std::size_t(options_.neighbours), 3 * scale_);
       Pass refined = linker.run(best.motion, &offset);
       refined.local_field = true;
       if (!better(std::move(refined))) break;
     }
+    return best;
+  }
 
-    // Record the links.
+  // The links of scan t: tracks moved on, kept in memory or ended; the detections left
+  // start new tracks.
+  void record(std::size_t t, const std::vector<Eigen::Vector3d>& base, std::size_t fresh,
+              const Pass& best, ScanLinks& report) {
+    const Detections& scan = scans_[t];
     report.previous = fresh;
     report.drift = best.motion.drift;
     report.gradient = best.motion.gradient;
@@ -605,7 +683,7 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
     Eigen::Vector3d moved = Eigen::Vector3d::Zero();
     std::vector<std::size_t> still_active;
     for (std::size_t s = 0; s < base.size(); ++s) {
-      Track& track = tracks[active[s]];
+      Track& track = tracks_[active_[s]];
       const std::int64_t j = best.target[s];
       if (j >= 0) {
         const auto jj = std::size_t(j);
@@ -617,17 +695,17 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
         track.at = scan.position.row(Eigen::Index(jj)).transpose();
         track.last_scan = t;
         track.seen.emplace_back(t, jj);
-        still_active.push_back(active[s]);
+        still_active.push_back(active_[s]);
         continue;
       }
       if (s < fresh) {
         ++report.unlinked;
-        report.unlinked_tracks.push_back(std::int64_t(active[s]));
+        report.unlinked_tracks.push_back(std::int64_t(active_[s]));
       }
-      if (t - track.last_scan <= std::size_t(options.memory)) {
+      if (t - track.last_scan <= std::size_t(options_.memory)) {
         track.at = best.expected[s];
         ++report.kept;
-        still_active.push_back(active[s]);
+        still_active.push_back(active_[s]);
       } else {
         ++report.ended;
       }
@@ -636,71 +714,40 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
     const std::size_t fresh_links = report.linked - report.relinked;
     if (fresh_links) report.mean_displacement = moved / double(fresh_links);
 
-    active = std::move(still_active);
-    report.first_new_track = std::int64_t(tracks.size());
+    active_ = std::move(still_active);
+    report.first_new_track = std::int64_t(tracks_.size());
     for (std::size_t j = 0; j < scan.size(); ++j) {
       if (taken[j]) continue;
       report.new_detections.push_back(j);
       start_track(t, j);
     }
     report.started = report.new_detections.size();
-    sum.scans.push_back(std::move(report));
   }
-  sum.tracks = tracks.size();
 
-  // The run: one grain per track, one frame per scan.
-  Trajectories run;
-  RunHeader& h = run.header;
-  h.length_unit = scans.front().length_unit;
-  h.time_unit = "cycle";
-  h.voxel_size = scans.front().voxel_size;
-  for (const Detections& d : scans)
-    h.has_axis = h.has_axis || d.has_axis;
-  h.has_hole_contact = h.has_axis;
-  h.id.resize(tracks.size());
-  h.radius.assign(tracks.size(), kNaN);
-  for (std::size_t k = 0; k < tracks.size(); ++k) {
-    h.id[k] = std::int64_t(k);
-    double total = 0;
-    std::size_t n = 0;
-    for (const auto& [t, j] : tracks[k].seen) {
-      const double r = scans[t].radius[j];
-      if (std::isfinite(r)) {
-        total += r;
-        ++n;
-      }
-    }
-    if (n) h.radius[k] = total / double(n);
-  }
-  {
-    std::ostringstream reach_text;
-    reach_text.precision(12);
-    reach_text << reach << " " << h.length_unit;
-    h.parameters["link/max_displacement"] = reach_text.str();
-    h.parameters["link/memory"] = std::to_string(options.memory);
-    h.parameters["link/drift"] = options.estimate_drift ? "on" : "off";
-    h.parameters["link/local_field"] = options.local_field ? "on" : "off";
-  }
-  run.frames.reserve(scans.size());
-  for (std::size_t t = 0; t < scans.size(); ++t) {
-    Frame frame = Frame::unknown(h);
-    frame.step = scans[t].frame;
-    frame.time = double(scans[t].frame);
-    run.frames.push_back(std::move(frame));
-  }
-  for (std::size_t k = 0; k < tracks.size(); ++k) {
-    const auto g = Eigen::Index(k);
-    for (const auto& [t, j] : tracks[k].seen) {
-      const Detections& d = scans[t];
-      Frame& frame = run.frames[t];
-      frame.position.row(g) = d.position.row(Eigen::Index(j));
-      if (d.has_axis) {
-        frame.axis.row(g) = d.axis.row(Eigen::Index(j));
-        frame.hole_contact[k] = d.hole_contact[j];
-      }
-    }
-  }
-  return run;
+  const std::vector<Detections>& scans_;
+  const LinkOptions& options_;
+  const double reach_, scale_;
+  std::vector<Track> tracks_;
+  std::vector<std::size_t> active_;  // tracks that may still be linked
+};
+
+}  // namespace
+
+Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions& options,
+                        LinkSummary* summary) {
+  check_scans(scans, options);
+  const auto [reach, scale] = reach_and_scale(scans, options);
+  LinkSummary local_summary;
+  LinkSummary& sum = summary ? *summary : local_summary;
+  sum = LinkSummary{};
+  sum.max_displacement = reach;
+  sum.length_unit = scans.front().length_unit;
+  TrackBuilder tracks(scans, options, reach, scale);
+  sum.scans.push_back(tracks.first_scan());
+  for (std::size_t t = 1; t < scans.size(); ++t)
+    sum.scans.push_back(tracks.next_scan(t));
+  sum.tracks = tracks.track_count();
+  return tracks.run();
 }
 
 }  // namespace granmem

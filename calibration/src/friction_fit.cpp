@@ -232,9 +232,11 @@ std::vector<double> noisy_dr(const CycleObservables& simulated, const Eigen::Vec
   return dr;
 }
 
-FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<FrictionRun>& runs,
-                         const FrictionFitOptions& options) {
-  const FrictionFitOptions& o = options;
+namespace {
+
+// ln(mu_s) over the runs, after checking that they can carry a polynomial of the degree.
+std::pair<double, double> log_friction_range(const std::vector<FrictionRun>& runs,
+                                             const FrictionFitOptions& o) {
   if (o.degree < 1) throw Error("friction fit: the polynomial degree must be at least 1");
   if (runs.size() < std::size_t(o.degree) + 1) {
     throw Error("friction fit: " + std::to_string(runs.size()) + " simulated runs, need at least " +
@@ -250,87 +252,100 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   }
   if (!(hi > lo)) throw Error("friction fit: the runs must differ in mu_s");
   if (o.probabilities.empty()) throw Error("friction fit: no CDF levels");
+  return {lo, hi};
+}
 
-  // The experiment's summaries and their sampling covariance.
-  // Groups: the pooled window, or each cycle of it.
-  std::map<std::int64_t, std::vector<double>> by_cycle;
+// The experiment's summaries: the quantiles of log(dr) (over the pooled window, or each of
+// its cycles) where the CDFs are compared, the smoothed CDF there, and its sampling
+// covariance (a bootstrap over grains).
+struct MeasuredSummaries {
+  SummaryLevels tau;
   std::vector<double> log_dr;
+  Eigen::VectorXd target;
+  Eigen::MatrixXd covariance;
+};
+
+MeasuredSummaries measured_summaries(const CycleObservables& experiment,
+                                     const FrictionFitOptions& o, Random& random) {
+  MeasuredSummaries m;
+  std::map<std::int64_t, std::vector<double>> by_cycle;
   std::vector<std::size_t> grain_of;
   std::vector<std::int64_t> cycle_of;
   for (std::size_t k = 0; k < experiment.dr.size(); ++k) {
     if (experiment.dr[k] > 0 && std::isfinite(experiment.dr[k])) {
-      log_dr.push_back(std::log(experiment.dr[k]));
+      m.log_dr.push_back(std::log(experiment.dr[k]));
       grain_of.push_back(experiment.dr_grain[k]);
       cycle_of.push_back(o.per_cycle && !experiment.dr_cycle.empty() ? experiment.dr_cycle[k] : 0);
-      by_cycle[cycle_of.back()].push_back(log_dr.back());
+      by_cycle[cycle_of.back()].push_back(m.log_dr.back());
     }
   }
-  SummaryLevels tau;
-  tau.levels = Eigen::Index(o.probabilities.size());
+  m.tau.levels = Eigen::Index(o.probabilities.size());
   for (const auto& [c, values] : by_cycle) {
     if (values.size() < 10 * o.probabilities.size()) {
       throw Error("friction fit: " + std::to_string(values.size()) + " measured displacements" +
                   (c ? " in cycle " + std::to_string(c) : std::string()) + ", too few for " +
                   std::to_string(o.probabilities.size()) + " CDF levels");
     }
-    tau.cycle.push_back(c);
+    m.tau.cycle.push_back(c);
     for (double p : o.probabilities)
-      tau.tau.push_back(quantile(values, p));
+      m.tau.tau.push_back(quantile(values, p));
   }
   if (by_cycle.empty()) throw Error("friction fit: no measured displacement");
-  const Eigen::Index nj = tau.size();
   std::size_t grains = 0;
   const std::vector<std::size_t> g = compact(grain_of, &grains);
-  GrainSums exp_sums(grains, tau);
-  for (std::size_t k = 0; k < log_dr.size(); ++k)
-    add_value(exp_sums, g[k], tau.group(cycle_of[k]), log_dr[k], tau, o.kernel_width);
-  const Eigen::VectorXd target = exp_sums.cdf();
-  Random random(o.seed);
-  const Eigen::MatrixXd exp_cov = bootstrap_covariance(exp_sums, o.bootstrap, random);
+  GrainSums sums(grains, m.tau);
+  for (std::size_t k = 0; k < m.log_dr.size(); ++k)
+    add_value(sums, g[k], m.tau.group(cycle_of[k]), m.log_dr[k], m.tau, o.kernel_width);
+  m.target = sums.cdf();
+  m.covariance = bootstrap_covariance(sums, o.bootstrap, random);
+  return m;
+}
 
-  const SimulatedSummaries model(runs, tau, o);
-  const bool fit_noise = o.noise == NoiseModel::fitted;
-  double log_mu = 0.5 * (lo + hi);
-  double sigma = o.noise == NoiseModel::fixed ? o.noise_sigma : 0.0;
-
-  // Start from the best point of a grid (the experiment's errors only): the cost need not be
-  // convex in the noise.
-  {
-    const Eigen::VectorXd weight = exp_cov.diagonal().cwiseMax(1e-12).cwiseInverse();
-    std::vector<double> sigmas{sigma};
-    if (fit_noise) {
-      const double median = std::exp(quantile(log_dr, 0.5));
-      const double top = median / o.noise_shape.norm();
-      sigmas.clear();
-      for (int k = 0; k <= 16; ++k)
-        sigmas.push_back(top * k / 16.0);
-    }
-    double best = std::numeric_limits<double>::infinity();
-    for (double s : sigmas) {
-      for (int k = 0; k <= 24; ++k) {
-        const double m = lo + (hi - lo) * k / 24.0;
-        const Eigen::VectorXd d = model.predict(m, s) - target;
-        const double c = d.cwiseProduct(d).dot(weight);
-        if (c < best) {
-          best = c;
-          log_mu = m;
-          sigma = s;
-        }
+// The start of the fit: the best point of a grid (the experiment's errors only), since the
+// cost need not be convex in the noise.
+void grid_start(const SimulatedSummaries& model, const MeasuredSummaries& measured,
+                const FrictionFitOptions& o, double lo, double hi, double& log_mu, double& sigma) {
+  const Eigen::VectorXd weight = measured.covariance.diagonal().cwiseMax(1e-12).cwiseInverse();
+  std::vector<double> sigmas{sigma};
+  if (o.noise == NoiseModel::fitted) {
+    const double median = std::exp(quantile(measured.log_dr, 0.5));
+    const double top = median / o.noise_shape.norm();
+    sigmas.clear();
+    for (int k = 0; k <= 16; ++k)
+      sigmas.push_back(top * k / 16.0);
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (double s : sigmas) {
+    for (int k = 0; k <= 24; ++k) {
+      const double m = lo + (hi - lo) * k / 24.0;
+      const Eigen::VectorXd d = model.predict(m, s) - measured.target;
+      const double c = d.cwiseProduct(d).dot(weight);
+      if (c < best) {
+        best = c;
+        log_mu = m;
+        sigma = s;
       }
     }
   }
+}
 
-  FrictionFit fit;
+// The generalized least-squares fit in two rounds: the simulation's covariance depends on
+// the noise and, through the polynomial's leverage, on mu_s; both are taken at the previous
+// round's fit. Sets the fit's convergence, chi2, error of ln(mu_s) and of the noise, and
+// returns the share of the summaries' variance that comes from the runs' scatter.
+double least_squares_rounds(const SimulatedSummaries& model, const MeasuredSummaries& measured,
+                            const FrictionFitOptions& o, std::size_t run_count, double lo,
+                            double hi, Random& random, double& log_mu, double& sigma,
+                            FrictionFit& fit) {
+  const Eigen::Index nj = measured.tau.size();
+  const bool fit_noise = o.noise == NoiseModel::fitted;
   ceres::Problem::Options po;
-  Eigen::MatrixXd run_cov;
-  double estimated_share = 0;  // of the summaries' variance, the part from the runs' scatter
-  // Two rounds: the simulation's covariance depends on the noise and, through the
-  // polynomial's leverage, on mu_s; both are taken at the previous round's fit.
+  double estimated_share = 0;
   for (int round = 0; round < 2; ++round) {
-    run_cov = Eigen::MatrixXd::Zero(nj, nj);
-    for (std::size_t k = 0; k < runs.size(); ++k)
+    Eigen::MatrixXd run_cov = Eigen::MatrixXd::Zero(nj, nj);
+    for (std::size_t k = 0; k < run_count; ++k)
       run_cov +=
-          bootstrap_covariance(model.run_sums(k, sigma), o.bootstrap, random) / double(runs.size());
+          bootstrap_covariance(model.run_sums(k, sigma), o.bootstrap, random) / double(run_count);
     // A packing is one realization of a chaotic system: runs that differ only in friction
     // scatter about any smooth trend by more than their grains' sampling error (a run may
     // settle into a nearly reversible cycle, or not), and mostly along one direction (all
@@ -345,14 +360,14 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
       fit.overdispersion = std::max(1.0, residual.trace() / run_cov.trace());
     }
     const double leverage = model.leverage(log_mu);
-    Eigen::MatrixXd cov = exp_cov + excess + leverage * (run_cov + excess);
+    Eigen::MatrixXd cov = measured.covariance + excess + leverage * (run_cov + excess);
     estimated_share = (1 + leverage) * excess.trace() / cov.trace();
     cov.diagonal().array() += 1e-12;
     const Eigen::MatrixXd whitening = cov.llt().matrixL().solve(Eigen::MatrixXd::Identity(nj, nj));
 
     ceres::Problem problem(po);
     auto* cost = new ceres::DynamicNumericDiffCostFunction<SummaryResidual, ceres::CENTRAL>(
-        new SummaryResidual{&model, target, whitening});
+        new SummaryResidual{&model, measured.target, whitening});
     cost->AddParameterBlock(1);
     cost->AddParameterBlock(1);
     cost->SetNumResiduals(int(nj));
@@ -382,6 +397,115 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
       fit.noise_sigma_error = fit_noise ? std::sqrt(var_sigma) * fit.error_scale : 0.0;
     }
   }
+  return estimated_share;
+}
+
+// Cross-validation across packings: the summaries' covariance, estimated from a few spare
+// runs, cannot see every direction in which one packing differs from another; fitting twin
+// runs of known friction with the other seeds' runs measures how far a realization moves
+// the fitted mu_s. The interval takes the larger of the two errors (and then Student's t
+// with as many dof as runs tested).
+void cross_validate(const std::vector<FrictionRun>& runs, const FrictionFitOptions& o,
+                    FrictionFit& fit, double& t) {
+  FrictionFitOptions inner = o;
+  inner.cross_validate = false;
+  inner.noise = NoiseModel::none;  // simulated against simulated: no locating noise
+  double sum2 = 0;
+  for (const FrictionRun& held_out : runs) {
+    const double m = std::log(held_out.mu_s);
+    std::vector<FrictionRun> others;
+    double others_lo = std::numeric_limits<double>::infinity(), others_hi = -others_lo;
+    for (const FrictionRun& r : runs) {
+      if (r.seed == held_out.seed) continue;
+      others.push_back(r);
+      others_lo = std::min(others_lo, std::log(r.mu_s));
+      others_hi = std::max(others_hi, std::log(r.mu_s));
+    }
+    // Interior frictions only: at the range's ends the bounded fit cannot err outwards.
+    if (others.size() < std::size_t(o.degree) + 1 || !(others_lo < m && m < others_hi)) continue;
+    try {
+      const FrictionFit f = fit_friction(held_out.observables, others, inner);
+      sum2 += std::pow(std::log(f.mu_s) - m, 2);
+      ++fit.cross_validations;
+    } catch (const Error&) {
+      // too few distinct frictions among the others: no test from this run
+    }
+  }
+  if (fit.cross_validations > 0) {
+    fit.cross_validated_sigma = std::sqrt(sum2 / double(fit.cross_validations));
+    if (fit.cross_validated_sigma > fit.log_mu_s_sigma) {
+      fit.log_mu_s_sigma = fit.cross_validated_sigma;
+      t = student_t_975(double(fit.cross_validations));
+    }
+  }
+}
+
+// The curves of the figure: thresholds, the experiment's CDF with its errors, the model's
+// at the fit and each run's.
+void fitted_curves(const SimulatedSummaries& model, const MeasuredSummaries& measured,
+                   double log_mu, double sigma, FrictionFit& fit) {
+  const Eigen::Index nj = measured.tau.size();
+  for (Eigen::Index j = 0; j < nj; ++j) {
+    fit.thresholds.push_back(std::exp(measured.tau.tau[std::size_t(j)]));
+    fit.threshold_cycle.push_back(measured.tau.cycle[std::size_t(j / measured.tau.levels)]);
+  }
+  const Eigen::VectorXd at_fit = model.predict(log_mu, sigma);
+  for (Eigen::Index j = 0; j < nj; ++j) {
+    fit.experiment_cdf.push_back(measured.target(j));
+    fit.experiment_error.push_back(std::sqrt(measured.covariance(j, j)));
+    fit.model_cdf.push_back(at_fit(j));
+  }
+  const Eigen::MatrixXd& per_run = model.run_cdfs(sigma);
+  for (Eigen::Index k = 0; k < per_run.rows(); ++k) {
+    const Eigen::VectorXd row = per_run.row(k).transpose();
+    fit.run_cdf.emplace_back(row.data(), row.data() + nj);
+  }
+}
+
+std::string method_text(const FrictionFitOptions& o, const FrictionFit& fit,
+                        const SummaryLevels& tau, double spare, double effective_dof) {
+  return "Ceres generalized least squares on the smoothed CDF of log(dr) at the experiment's " +
+         std::to_string(tau.levels) + " quantiles" +
+         (o.per_cycle ? " of each of its " + std::to_string(tau.cycle.size()) + " cycles"
+                      : std::string(" of the pooled window")) +
+         ", covariance from a bootstrap over grains of the experiment and of the "
+         "runs plus the realization noise measured on the runs' scatter about the fit across "
+         "frictions (x" +
+         format_number(fit.overdispersion) + " the sampling variance, from " +
+         format_number(spare) + " spare runs)" +
+         "; 95 % interval from Ceres' covariance of ln(mu_s)" +
+         (effective_dof > 0
+              ? ", Student's t with " + format_number(effective_dof) + " effective dof"
+              : std::string()) +
+         std::string(fit.error_scale > 1 ? ", widened by sqrt(chi2/dof)" : "") +
+         (fit.cross_validations > 0
+              ? "; cross-validated across packings (" + std::to_string(fit.cross_validations) +
+                    " twin runs of known mu_s fitted with the other seeds' runs: RMS error " +
+                    format_number(fit.cross_validated_sigma) + " in ln mu_s" +
+                    (fit.cross_validated_sigma >= fit.log_mu_s_sigma
+                         ? ", which sets the interval, Student's t with " +
+                               std::to_string(fit.cross_validations) + " dof)"
+                         : ", within Ceres' error)")
+              : std::string()) +
+         (o.noise == NoiseModel::fitted ? "; locating noise fitted jointly" : "");
+}
+
+}  // namespace
+
+FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<FrictionRun>& runs,
+                         const FrictionFitOptions& options) {
+  const FrictionFitOptions& o = options;
+  const auto [lo, hi] = log_friction_range(runs, o);
+  Random random(o.seed);
+  const MeasuredSummaries measured = measured_summaries(experiment, o, random);
+  const SimulatedSummaries model(runs, measured.tau, o);
+  double log_mu = 0.5 * (lo + hi);
+  double sigma = o.noise == NoiseModel::fixed ? o.noise_sigma : 0.0;
+  grid_start(model, measured, o, lo, hi, log_mu, sigma);
+
+  FrictionFit fit;
+  const double estimated_share =
+      least_squares_rounds(model, measured, o, runs.size(), lo, hi, random, log_mu, sigma, fit);
   fit.mu_s = std::exp(log_mu);
   // The realization noise is estimated from the runs' spare degrees of freedom, the
   // bootstrap's part is known well: Satterthwaite's effective dof of their sum sets
@@ -390,85 +514,13 @@ FrictionFit fit_friction(const CycleObservables& experiment, const std::vector<F
   const double effective_dof =
       estimated_share > 0 && spare > 0 ? spare / (estimated_share * estimated_share) : 0.0;
   double t = student_t_975(effective_dof);
-  // Cross-validation across packings: the summaries' covariance, estimated from a few spare
-  // runs, cannot see every direction in which one packing differs from another; fitting
-  // twin runs of known friction with the other seeds' runs measures how far a realization
-  // moves the fitted mu_s. The interval takes the larger of the two errors.
-  if (o.cross_validate) {
-    FrictionFitOptions inner = o;
-    inner.cross_validate = false;
-    inner.noise = NoiseModel::none;  // simulated against simulated: no locating noise
-    double sum2 = 0;
-    for (const FrictionRun& held_out : runs) {
-      const double m = std::log(held_out.mu_s);
-      std::vector<FrictionRun> others;
-      double others_lo = std::numeric_limits<double>::infinity(), others_hi = -others_lo;
-      for (const FrictionRun& r : runs) {
-        if (r.seed == held_out.seed) continue;
-        others.push_back(r);
-        others_lo = std::min(others_lo, std::log(r.mu_s));
-        others_hi = std::max(others_hi, std::log(r.mu_s));
-      }
-      // Interior frictions only: at the range's ends the bounded fit cannot err outwards.
-      if (others.size() < std::size_t(o.degree) + 1 || !(others_lo < m && m < others_hi)) continue;
-      try {
-        const FrictionFit f = fit_friction(held_out.observables, others, inner);
-        sum2 += std::pow(std::log(f.mu_s) - m, 2);
-        ++fit.cross_validations;
-      } catch (const Error&) {
-        // too few distinct frictions among the others: no test from this run
-      }
-    }
-    if (fit.cross_validations > 0) {
-      fit.cross_validated_sigma = std::sqrt(sum2 / double(fit.cross_validations));
-      if (fit.cross_validated_sigma > fit.log_mu_s_sigma) {
-        fit.log_mu_s_sigma = fit.cross_validated_sigma;
-        t = student_t_975(double(fit.cross_validations));
-      }
-    }
-  }
+  if (o.cross_validate) cross_validate(runs, o, fit, t);
   fit.mu_s_ci95 = {std::exp(log_mu - t * fit.log_mu_s_sigma),
                    std::exp(log_mu + t * fit.log_mu_s_sigma)};
   fit.noise_sigma = sigma;
   fit.simulations = runs.size();
-  for (Eigen::Index j = 0; j < nj; ++j) {
-    fit.thresholds.push_back(std::exp(tau.tau[std::size_t(j)]));
-    fit.threshold_cycle.push_back(tau.cycle[std::size_t(j / tau.levels)]);
-  }
-  const Eigen::VectorXd at_fit = model.predict(log_mu, sigma);
-  for (Eigen::Index j = 0; j < nj; ++j) {
-    fit.experiment_cdf.push_back(target(j));
-    fit.experiment_error.push_back(std::sqrt(exp_cov(j, j)));
-    fit.model_cdf.push_back(at_fit(j));
-  }
-  const Eigen::MatrixXd& per_run = model.run_cdfs(sigma);
-  for (Eigen::Index k = 0; k < per_run.rows(); ++k) {
-    const Eigen::VectorXd row = per_run.row(k).transpose();
-    fit.run_cdf.emplace_back(row.data(), row.data() + nj);
-  }
-  fit.method =
-      "Ceres generalized least squares on the smoothed CDF of log(dr) at the experiment's " +
-      std::to_string(tau.levels) + " quantiles" +
-      (o.per_cycle ? " of each of its " + std::to_string(tau.cycle.size()) + " cycles"
-                   : std::string(" of the pooled window")) +
-      ", covariance from a bootstrap over grains of the experiment and of the "
-      "runs plus the realization noise measured on the runs' scatter about the fit across "
-      "frictions (x" +
-      format_number(fit.overdispersion) + " the sampling variance, from " + format_number(spare) +
-      " spare runs)" + "; 95 % interval from Ceres' covariance of ln(mu_s)" +
-      (effective_dof > 0 ? ", Student's t with " + format_number(effective_dof) + " effective dof"
-                         : std::string()) +
-      std::string(fit.error_scale > 1 ? ", widened by sqrt(chi2/dof)" : "") +
-      (fit.cross_validations > 0
-           ? "; cross-validated across packings (" + std::to_string(fit.cross_validations) +
-                 " twin runs of known mu_s fitted with the other seeds' runs: RMS error " +
-                 format_number(fit.cross_validated_sigma) + " in ln mu_s" +
-                 (fit.cross_validated_sigma >= fit.log_mu_s_sigma
-                      ? ", which sets the interval, Student's t with " +
-                            std::to_string(fit.cross_validations) + " dof)"
-                      : ", within Ceres' error)")
-           : std::string()) +
-      (fit_noise ? "; locating noise fitted jointly" : "");
+  fitted_curves(model, measured, log_mu, sigma, fit);
+  fit.method = method_text(o, fit, measured.tau, spare, effective_dof);
   return fit;
 }
 

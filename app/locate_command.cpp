@@ -11,30 +11,6 @@
 #include "tracking_steps.hpp"
 
 namespace granmem::app {
-namespace {
-
-// "x0,y0,z0,nx,ny,nz" (voxels) -> the box to read.
-Region parse_region(const std::string& text) {
-  std::vector<std::int64_t> v;
-  std::stringstream s(text);
-  for (std::string item; std::getline(s, item, ',');) {
-    std::size_t used = 0;
-    long long n = -1;
-    try {
-      n = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || n < 0) {
-      throw Error("--region '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels");
-    }
-    v.push_back(n);
-  }
-  if (v.size() != 6) throw Error("--region '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels");
-  return Region{v[0], v[1], v[2], v[3], v[4], v[5]};
-}
-
-}  // namespace
 
 void add_locate_options(CLI::App* cmd, LocateArgs& args) {
   cmd->add_option("--diameter,-d", args.diameter,
@@ -76,7 +52,7 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args) {
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame) {
   ScanLocateOptions o;
   o.read.dataset = args.dataset;
-  if (!args.region.empty()) o.read.region = parse_region(args.region);
+  if (!args.region.empty()) o.read.region = parse_region(args.region, "--region");
   if (!args.voxel_size.empty()) {
     const VoxelSize v = parse_voxel_size(args.voxel_size, "--voxel-size");
     if (v.unit.empty() || !is_physical_length_unit(v.unit)) {

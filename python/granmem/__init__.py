@@ -53,12 +53,14 @@ def _vector3(value):
     return tuple(float(x) for x in v)
 
 
-def read_stack(path, dataset=""):
-    """Reads a scan (multi-page TIFF, folder of slices, or HDF5 ``dataset``).
+def read_stack(path, dataset="", region=None):
+    """Reads a scan (multi-page TIFF, folder of slices, or HDF5 ``dataset``); ``region``
+    "x0,y0,z0,nx,ny,nz" (voxels) reads only that box, as ``granmem locate --region``.
 
     Returns ``(stack, voxel_size, unit)``: the (z, y, x) array, the voxel size (x, y, z) or
     None when the file does not say, and its unit."""
-    return _granmem.read_stack(os.fspath(path), dataset)
+    return _granmem.read_stack(os.fspath(path), dataset,
+                               None if region is None else str(region))
 
 
 def write_tiff(stack, path, voxel_size=None, unit=""):

@@ -162,9 +162,11 @@ py::array array_of(const Stack& s) {
   return std::move(a);
 }
 
-py::tuple read_stack_py(const std::filesystem::path& path, const std::string& dataset) {
+py::tuple read_stack_py(const std::filesystem::path& path, const std::string& dataset,
+                        const std::optional<std::string>& region) {
   StackReadOptions options;
   options.dataset = dataset;
+  if (region) options.region = parse_region(*region, "region");
   Stack s;
   {
     py::gil_scoped_release release;
@@ -843,7 +845,8 @@ PYBIND11_MODULE(_granmem, m) {
     }
   });
 
-  m.def("read_stack", &read_stack_py, py::arg("path"), py::arg("dataset") = "");
+  m.def("read_stack", &read_stack_py, py::arg("path"), py::arg("dataset") = "",
+        py::arg("region") = py::none());
   m.def("write_tiff", &write_tiff_py, py::arg("stack"), py::arg("path"),
         py::arg("voxel_size") = py::none(), py::arg("unit") = "");
   m.def("locate", &locate_py, py::arg("stack"), py::arg("diameter"),

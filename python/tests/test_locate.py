@@ -75,6 +75,10 @@ def test_locate_in_python_equals_the_command_line(tmp_path, cli):
     again, voxel_read, unit = granmem.read_stack(tmp_path / "scan.tif")
     np.testing.assert_array_equal(again, stack)
     assert unit == "mm" and voxel_read == pytest.approx(voxel)
+    box, _, _ = granmem.read_stack(tmp_path / "scan.tif", region="2,3,4,5,6,7")
+    np.testing.assert_array_equal(box, stack[4:11, 3:9, 2:7])  # (z, y, x)
+    with pytest.raises(granmem.Error, match="region '2,3,4,5,6': expected x0,y0,z0,nx,ny,nz"):
+        granmem.read_stack(tmp_path / "scan.tif", region="2,3,4,5,6")
     from_python = granmem.locate(stack, diameter="5mm", voxel_size=voxel, unit="mm")
     assert list(from_cli.columns) == list(from_python.columns)
     for c in from_cli.columns:

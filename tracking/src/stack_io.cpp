@@ -1,9 +1,12 @@
 // read_stack() and write_tiff(): the source's format from its first bytes, and the
 // region checks shared by the readers.
 #include <array>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <new>
+#include <string_view>
+#include <vector>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/memory_budget.hpp"
@@ -95,6 +98,25 @@ Stack allocate_stack(const Box& box, int bits, const std::string& source) {
 }
 
 }  // namespace stack_io
+
+Region parse_region(const std::string& text, const std::string& what) {
+  const std::string expected = what + " '" + text + "': expected x0,y0,z0,nx,ny,nz in voxels";
+  std::vector<std::int64_t> v;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string_view item = std::string_view(text).substr(
+        start, comma == std::string::npos ? std::string::npos : comma - start);
+    std::int64_t n = -1;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), n);
+    if (ec != std::errc() || end != item.data() + item.size() || n < 0) throw Error(expected);
+    v.push_back(n);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (v.size() != 6) throw Error(expected);
+  return Region{v[0], v[1], v[2], v[3], v[4], v[5]};
+}
 
 Stack read_stack(const std::filesystem::path& source, const StackReadOptions& options) {
   const std::string name = source.string();

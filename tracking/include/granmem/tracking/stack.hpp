@@ -52,6 +52,10 @@ struct Region {
   std::int64_t nx = 0, ny = 0, nz = 0;  // 0: to the end along that axis
 };
 
+// A region as users type it: "x0,y0,z0,nx,ny,nz" in voxels, whole numbers >= 0. Throws Error
+// naming `what` (the option) for anything else.
+Region parse_region(const std::string& text, const std::string& what);
+
 struct StackReadOptions {
   std::string dataset;           // HDF5 sources: the dataset, (z, y, x) order
   std::optional<Region> region;  // crop

@@ -124,7 +124,7 @@ def _scans(detections):
 
 
 def link(detections, length_unit=None, voxel_size=None, max_displacement="auto", memory=2,
-         collective_motion=True, container=None, container_size=None):
+         collective_motion=True, container=None, container_size=None, progress=None):
     """Links the detections of successive scans into tracks, as ``granmem link``.
 
     ``detections``: a list of DataFrames, one per scan in order (e.g. from ``locate``), or
@@ -133,7 +133,9 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
     the scans have axes. ``container`` ("xmin,ymin,zmin,xmax,ymax,zmax cm") or
     ``container_size`` ("LX,LY,LZ cm", placed at the packing's extent in the first scan)
     moves the positions into the container's frame. ``collective_motion=False``: no
-    estimate of the packing's drift and deformation between scans (``--no-collective-motion``)."""
+    estimate of the packing's drift and deformation between scans (``--no-collective-motion``).
+    ``progress``: called with ``{"line": "linking scan k of n"}`` as each scan begins; Ctrl-C
+    stops between two scans (KeyboardInterrupt)."""
     scans, parts = _scans(detections)
     if length_unit is None:
         length_unit = parts[0].attrs.get("length_unit", "voxel") if parts else "voxel"
@@ -142,7 +144,7 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
     columns, units, summary = _granmem.link(
         scans, length_unit, _vector3(voxel_size), _length(max_displacement) if
         max_displacement != "auto" else "auto", int(memory), bool(collective_motion), container,
-        container_size)
+        container_size, progress)
     return _frame(columns, units, length_unit=length_unit, summary=summary)
 
 

@@ -350,59 +350,6 @@ Detections detections_of(const py::dict& columns, std::int64_t frame,
   return d;
 }
 
-py::tuple link_py(const py::list& scans, const std::string& length_unit,
-                  const std::optional<Vector3>& voxel_size, const std::string& max_displacement,
-                  int memory, bool drift, const std::optional<std::string>& container,
-                  const std::optional<std::string>& container_size) {
-  if (!is_length_unit(length_unit)) {
-    throw Error("length_unit '" + length_unit + "': expected m, cm, mm, um or voxel");
-  }
-  LinkRunOptions o;
-  o.max_displacement = max_displacement;
-  o.memory = memory;
-  o.collective_motion = drift;
-  o.container = container.value_or("");
-  o.container_size = container_size.value_or("");
-  o.validate();
-  std::vector<Detections> found;
-  std::vector<std::string> names;
-  for (const py::handle& scan : scans) {
-    const auto pair = scan.cast<py::tuple>();
-    found.push_back(detections_of(pair[0].cast<py::dict>(), pair[1].cast<std::int64_t>(),
-                                  length_unit, voxel_size));
-    names.push_back(found.back().source);
-  }
-  LinkRun linked;
-  {
-    py::gil_scoped_release release;
-    linked = link_run(std::move(found), names, o);
-  }
-  const LinkSummary& sum = linked.summary;
-  const Trajectories& run = linked.run;
-  py::list per_scan;
-  for (const ScanLinks& r : sum.scans) {
-    py::dict d;
-    d["frame"] = r.frame;
-    d["detections"] = r.detections;
-    d["linked"] = r.linked;
-    d["relinked"] = r.relinked;
-    d["started"] = r.started;
-    d["lost"] = r.unlinked;
-    d["linked_fraction"] = r.linked_fraction();
-    d["rms_residual"] = r.rms_residual;
-    per_scan.append(d);
-  }
-  py::dict summary;
-  summary["tracks"] = sum.tracks;
-  summary["max_displacement"] = sum.max_displacement;
-  summary["length_unit"] = sum.length_unit;
-  summary["notes"] = linked.notes;
-  summary["report"] = linked.Report();
-  summary["scans"] = per_scan;
-  const Table t = trajectory_table(run);
-  return py::make_tuple(columns_of(t), units_of(t), summary);
-}
-
 // ------------------------------------------------------------------------------ motion
 
 std::size_t frame_index(const Trajectories& run, std::int64_t frame) {
@@ -615,6 +562,62 @@ py::tuple locate_py(const py::array& array, const std::string& diameter,
   summary["length_unit"] = d.length_unit;
   summary["voxel_size"] = optional_vector(d.voxel_size);
   const Table t = to_table(d);
+  return py::make_tuple(columns_of(t), units_of(t), summary);
+}
+
+// ------------------------------------ link on its own thread: its scans as progress, Ctrl-C
+
+py::tuple link_py(const py::list& scans, const std::string& length_unit,
+                  const std::optional<Vector3>& voxel_size, const std::string& max_displacement,
+                  int memory, bool collective_motion, const std::optional<std::string>& container,
+                  const std::optional<std::string>& container_size, const py::object& progress) {
+  if (!is_length_unit(length_unit)) {
+    throw Error("length_unit '" + length_unit + "': expected m, cm, mm, um or voxel");
+  }
+  LinkRunOptions o;
+  o.max_displacement = max_displacement;
+  o.memory = memory;
+  o.collective_motion = collective_motion;
+  o.container = container.value_or("");
+  o.container_size = container_size.value_or("");
+  o.validate();
+  std::vector<Detections> found;
+  std::vector<std::string> names;
+  for (const py::handle& scan : scans) {
+    const auto pair = scan.cast<py::tuple>();
+    found.push_back(detections_of(pair[0].cast<py::dict>(), pair[1].cast<std::int64_t>(),
+                                  length_unit, voxel_size));
+    names.push_back(found.back().source);
+  }
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  o.log = [&](const std::string& line) { queue.push(Report{line, {}}); };
+  o.stop = &stop;
+  const LinkRun linked = run_interruptible([&] { return link_run(std::move(found), names, o); },
+                                           queue, stop, progress);
+  const LinkSummary& sum = linked.summary;
+  const Trajectories& run = linked.run;
+  py::list per_scan;
+  for (const ScanLinks& r : sum.scans) {
+    py::dict d;
+    d["frame"] = r.frame;
+    d["detections"] = r.detections;
+    d["linked"] = r.linked;
+    d["relinked"] = r.relinked;
+    d["started"] = r.started;
+    d["lost"] = r.unlinked;
+    d["linked_fraction"] = r.linked_fraction();
+    d["rms_residual"] = r.rms_residual;
+    per_scan.append(d);
+  }
+  py::dict summary;
+  summary["tracks"] = sum.tracks;
+  summary["max_displacement"] = sum.max_displacement;
+  summary["length_unit"] = sum.length_unit;
+  summary["notes"] = linked.notes;
+  summary["report"] = linked.Report();
+  summary["scans"] = per_scan;
+  const Table t = trajectory_table(run);
   return py::make_tuple(columns_of(t), units_of(t), summary);
 }
 
@@ -862,8 +865,9 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("seed") = RenderOptions{}.seed, py::arg("frame") = 0);
   m.def("link", &link_py, py::arg("scans"), py::arg("length_unit"),
         py::arg("voxel_size") = py::none(), py::arg("max_displacement") = "auto",
-        py::arg("memory") = LinkOptions{}.memory, py::arg("drift") = true,
-        py::arg("container") = py::none(), py::arg("container_size") = py::none());
+        py::arg("memory") = LinkOptions{}.memory, py::arg("collective_motion") = true,
+        py::arg("container") = py::none(), py::arg("container_size") = py::none(),
+        py::arg("progress") = py::none());
   m.def(
       "read_run", [](const std::filesystem::path& path) { return run_arrays(read_run(path)); },
       py::arg("path"));

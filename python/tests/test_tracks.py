@@ -74,6 +74,21 @@ def test_a_trackpy_table_links_to_the_true_identities():
     assert len(owner) == 18
 
 
+def test_link_reports_each_scan_and_stops_on_ctrl_c():
+    first, second, _ = moved_lattice()
+    xyz = ["x", "y", "z"]
+    scans = [first[xyz].assign(frame=k) for k in range(3)] + [second[xyz].assign(frame=3)]
+    lines = []
+    granmem.link(scans, length_unit="mm", max_displacement="1mm",
+                 progress=lambda r: lines.append(r["line"]))
+    assert lines == ["linking scan 2 of 4", "linking scan 3 of 4", "linking scan 4 of 4"]
+
+    def stop(report):
+        raise KeyboardInterrupt  # as Ctrl-C would, between two scans
+    with pytest.raises(KeyboardInterrupt):
+        granmem.link(scans, length_unit="mm", max_displacement="1mm", progress=stop)
+
+
 def test_store_round_trip_and_the_command_line_agree(tmp_path, cli):
     first, second, _ = moved_lattice()
     table = pd.concat([first.assign(frame=0), second.assign(frame=1)])

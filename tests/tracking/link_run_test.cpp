@@ -33,6 +33,28 @@ std::vector<Detections> scans_of_three_grains() {
   return {scan(0, {a, b}), scan(0, {a + Eigen::Vector3d(0.2, 0, 0), c})};
 }
 
+// Linking says each scan as it begins and stops between two when asked (Python's Ctrl-C).
+TEST(LinkRun, EachScanIsSaidAndAStopEndsLinkingBeforeTheNext) {
+  const std::vector<Detections> scans{scan(0, {a, b}), scan(1, {a, b}), scan(2, {a, b}),
+                                      scan(3, {a, b})};
+  const std::vector<std::string> names{"s0", "s1", "s2", "s3"};
+  LinkRunOptions o;
+  std::vector<std::string> said;
+  o.log = [&](const std::string& line) { said.push_back(line); };
+  EXPECT_EQ(link_run(scans, names, o).run.frames.size(), 4u);
+  EXPECT_EQ(said, (std::vector<std::string>{"linking scan 2 of 4", "linking scan 3 of 4",
+                                            "linking scan 4 of 4"}));
+  std::atomic<bool> stop{false};
+  o.stop = &stop;
+  said.clear();
+  o.log = [&](const std::string& line) {
+    said.push_back(line);
+    stop = line == "linking scan 3 of 4";
+  };
+  expect_error([&] { link_run(scans, names, o); }, {"link: stopped before scan 4 of 4"});
+  EXPECT_EQ(said.size(), 2u);
+}
+
 TEST(LinkRun, ScansThatAllSayOneFrameAreNumberedInOrder) {
   const LinkRun r = link_run(scans_of_three_grains(), {"s0", "s1"}, {});
   ASSERT_EQ(r.run.frames.size(), 2u);

@@ -744,8 +744,13 @@ Trajectories link_scans(const std::vector<Detections>& scans, const LinkOptions&
   sum.length_unit = scans.front().length_unit;
   TrackBuilder tracks(scans, options, reach, scale);
   sum.scans.push_back(tracks.first_scan());
-  for (std::size_t t = 1; t < scans.size(); ++t)
+  for (std::size_t t = 1; t < scans.size(); ++t) {
+    const std::string what =
+        "scan " + std::to_string(t + 1) + " of " + std::to_string(scans.size());
+    if (options.stop && options.stop->load()) throw Error("link: stopped before " + what);
+    if (options.log) options.log("linking " + what);
     sum.scans.push_back(tracks.next_scan(t));
+  }
   sum.tracks = tracks.track_count();
   return tracks.run();
 }

@@ -46,6 +46,8 @@ LinkOptions link_options(const LinkRunOptions& o, const std::string& unit) {
   options.memory = o.memory;
   options.estimate_drift = o.collective_motion;
   options.local_field = o.collective_motion;
+  options.log = o.log;
+  options.stop = o.stop;
   return options;
 }
 

@@ -1,5 +1,8 @@
 #pragma once
 
+#include <atomic>
+#include <functional>
+
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
@@ -38,6 +41,10 @@ struct LinkOptions {
   bool local_field = true;
   int neighbours = 12;
   int refinements = 3;
+  // What linking is doing (a line per scan), and a flag (Python's Ctrl-C) that stops it
+  // between two scans with Error "link: stopped ...".
+  std::function<void(const std::string&)> log;
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // What linking scan k (from the scans before it) gave.

@@ -22,6 +22,9 @@ struct LinkRunOptions {
   // "LX,LY,LZ<unit>" (its position found from the packing's extent in the first scan):
   // positions are then stored in its frame and it is the run's box. Empty: neither.
   std::string container, container_size;
+  // A line per scan as it is linked, and a flag that stops between two (LinkOptions).
+  std::function<void(const std::string&)> log;
+  const std::atomic<bool>* stop = nullptr;
 
   // Checks what can be checked before any scan is read (Error naming the option).
   void validate() const;

@@ -531,6 +531,16 @@ auto run_interruptible(Job job, ReportQueue& queue, std::atomic<bool>& stop,
   return result;
 }
 
+// A job that says what it does a line at a time and stops on a flag (locate, link): the
+// queue of its lines and the flag, for run_interruptible.
+struct LineJob {
+  ReportQueue queue;
+  std::atomic<bool> stop{false};
+  std::function<void(const std::string&)> log() {
+    return [this](const std::string& line) { queue.push(Report{line, {}}); };
+  }
+};
+
 // ---------------------------------- locate on its own thread: its stages as progress, Ctrl-C
 
 py::tuple locate_py(const py::array& array, const std::string& diameter,
@@ -541,10 +551,9 @@ py::tuple locate_py(const py::array& array, const std::string& diameter,
   Stack stack = stack_of(array, voxel_size, unit);  // a copy: the caller's array stays as it is
   LocateOptions o =
       locate_options(stack, diameter, polarity, hole_fraction, beam, axis, passes, illumination);
-  ReportQueue queue;
-  std::atomic<bool> stop{false};
-  o.log = [&](const std::string& line) { queue.push(Report{line, {}}); };
-  o.stop = &stop;
+  LineJob job;
+  o.log = job.log();
+  o.stop = &job.stop;
   LocateSummary sum;
   const Detections d = run_interruptible(
       [&] {
@@ -552,7 +561,7 @@ py::tuple locate_py(const py::array& array, const std::string& diameter,
         found.frame = frame;
         return found;
       },
-      queue, stop, progress);
+      job.queue, job.stop, progress);
   py::dict summary;
   summary["candidates"] = sum.candidates;
   summary["located"] = sum.located;
@@ -589,12 +598,11 @@ py::tuple link_py(const py::list& scans, const std::string& length_unit,
                                   length_unit, voxel_size));
     names.push_back(found.back().source);
   }
-  ReportQueue queue;
-  std::atomic<bool> stop{false};
-  o.log = [&](const std::string& line) { queue.push(Report{line, {}}); };
-  o.stop = &stop;
+  LineJob job;
+  o.log = job.log();
+  o.stop = &job.stop;
   const LinkRun linked = run_interruptible([&] { return link_run(std::move(found), names, o); },
-                                           queue, stop, progress);
+                                           job.queue, job.stop, progress);
   const LinkSummary& sum = linked.summary;
   const Trajectories& run = linked.run;
   py::list per_scan;

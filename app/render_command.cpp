@@ -9,7 +9,7 @@
 #include "granmem/core/option_values.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
-#include "granmem/tracking/render.hpp"
+#include "granmem/tracking/render_run.hpp"
 #include "granmem/tracking/stack.hpp"
 
 namespace granmem::app {
@@ -34,16 +34,6 @@ std::vector<double> numbers(const std::string& text, const std::string& option, 
 }
 
 // "X[,Y,Z][ unit]" -> the voxel size in the run's unit.
-Eigen::Vector3d voxel_size(const std::string& text, const std::string& run_unit) {
-  const VoxelSize v = parse_voxel_size(text, "--voxel-size");
-  if (v.unit.empty() || v.unit == run_unit) return v.size;
-  if (!is_physical_length_unit(v.unit) || !is_physical_length_unit(run_unit)) {
-    throw Error("--voxel-size '" + text + "': cannot convert " + v.unit + " to the run's unit " +
-                run_unit);
-  }
-  return v.size * convert_length(1, v.unit, run_unit);
-}
-
 Beam beam_side(const std::string& text) {
   if (text == "+x") return Beam::plus_x;
   if (text == "-x") return Beam::minus_x;
@@ -141,28 +131,10 @@ void add_render(CLI::App& app) {
     std::vector<NamedPath> outputs{{"--out", args->out}};
     if (!args->truth.empty()) outputs.push_back({"--truth", args->truth});
     check_outputs(outputs, {{"run", args->run}});
-    const TrajectoryReader run(args->run);
-    const RunHeader& h = run.header();
-    std::size_t index = run.frame_count();
-    for (std::size_t t = 0; t < run.frame_count(); ++t) {
-      if (run.steps()[t] == args->frame) index = t;
-    }
-    if (index == run.frame_count()) {
-      std::string have = "it has no frames";
-      if (run.frame_count() > 0) {
-        have = "its frames are " + std::to_string(run.steps().front()) + " to " +
-               std::to_string(run.steps().back());
-      }
-      throw Error("--frame " + std::to_string(args->frame) + ": " + args->run +
-                  " has no such frame; " + have);
-    }
-
     RenderOptions o;
     o.diameter_px = args->diameter_px;
     o.slice_spacing_ratio = args->slice_spacing_ratio;
-    if (!args->voxel_size.empty()) o.voxel_size = voxel_size(args->voxel_size, h.length_unit);
     o.margin = args->margin;
-    o.length_unit = h.length_unit;
     o.bits = args->bits;
     o.polarity = args->polarity == "bright" ? Polarity::bright_grains : Polarity::dark_grains;
     o.hole_fraction = args->hole_fraction;
@@ -203,44 +175,16 @@ void add_render(CLI::App& app) {
     }
     if (args->no_artefacts) o = o.without_artefacts();
     o.seed = args->seed;
-    o.frame = args->frame;
 
-    const Frame frame = run.read_frame(index);
-    const std::vector<RenderedGrain> grains = rendered_grains(frame, h, args->seed);
-    if (grains.empty()) {
-      throw Error("--frame " + std::to_string(args->frame) + ": " + args->run +
-                  " has no grain with a position in that frame; nothing to draw");
-    }
-    // The truth goes to a temporary file first, and in place only once the scan is written;
-    // both places are checked before the drawing, which takes a while.
-    AtomicFile{args->out};
-    std::optional<AtomicFile> truth_file;
-    if (!args->truth.empty()) truth_file.emplace(args->truth);
-    Table truth;
-    Stack stack = render_scan(grains, o, &truth);
-    stack.source = args->run + " frame " + std::to_string(args->frame);
-
-    if (truth_file) {
-      std::ostringstream voxel;
-      voxel << std::setprecision(17) << stack.voxel_size->x() << " x " << stack.voxel_size->y()
-            << " x " << stack.voxel_size->z() << " " << h.length_unit;
-      std::vector<std::string> comment = {
-          "granmem render " + args->run + " --frame " + std::to_string(args->frame),
-          "positions and radius in voxels of " + voxel.str() + "; voxel (0,0,0) is the origin"};
-      for (const auto& [key, value] : used_options(*cmd))
-        comment.push_back(key + " = " + value);
-      write_csv(truth, *truth_file, comment);
-    }
-    write_tiff(stack, args->out);
-    if (truth_file) truth_file->commit();
-
-    const Eigen::Vector3d& v = *stack.voxel_size;
-    std::cout << "rendered " << grains.size() << " grains of frame " << args->frame << " of "
-              << args->run << ": " << stack.nx << " x " << stack.ny << " x " << stack.nz
-              << " voxels of " << v.x() << " x " << v.y() << " x " << v.z() << " " << h.length_unit
-              << ", " << stack.bits << "-bit" << (args->no_artefacts ? ", no artefacts" : "")
-              << "\nwrote " << args->out << "\n";
-    if (!args->truth.empty()) std::cout << "wrote " << args->truth << "\n";
+    RenderRunOptions options;
+    options.run = args->run;
+    options.frame = args->frame;
+    options.out = args->out;
+    options.truth = args->truth;
+    options.render = o;
+    options.voxel_size = args->voxel_size;
+    options.parameters = used_options(*cmd);
+    std::cout << render_run(options).Report();
   });
 }
 

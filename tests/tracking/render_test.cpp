@@ -9,6 +9,11 @@
 
 #include "checks.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "granmem/tracking/render_run.hpp"
+#include "granmem/tracking/stack.hpp"
+#include "temp_dir.hpp"
 
 namespace granmem {
 namespace {
@@ -510,6 +515,61 @@ TEST(Render, BadOptionsSayWhich) {
   flat.radius = 0;
   EXPECT_NE(testing::error_message([&] { render_scan({flat}, box(8, 8, 8)); }).find("radius"),
             std::string::npos);
+}
+
+}  // namespace
+}  // namespace granmem
+
+namespace granmem {
+namespace {
+
+// render as one call: the frame found by its label, the scan and its truth written, the
+// report; a frame the run does not have named with the frames it has, nothing written.
+class RenderRun : public testing::TempDirTest {};
+
+TEST_F(RenderRun, TheFrameByItsLabelDrawnAndWritten) {
+  Trajectories run;
+  run.header.length_unit = "mm";
+  run.header.id = {1, 2};
+  run.header.radius = {2.5, 2.5};
+  for (std::int64_t step : {10, 20}) {
+    Frame f = Frame::unknown(run.header);
+    f.step = step;
+    f.position << 5, 5, 5, 10.5, 5, 5;
+    run.frames.push_back(f);
+  }
+  write_trajectories(path("run.h5"), run);
+  RenderRunOptions o;
+  o.run = path("run.h5");
+  o.frame = 20;
+  o.out = path("scan.tif");
+  o.truth = path("truth.csv");
+  o.render.diameter_px = 10;
+  o.voxel_size = "0.5,0.5,0.5mm";
+  const RenderSummary s = render_run(o);
+  EXPECT_EQ(s.grains, 2u);
+  EXPECT_EQ(s.voxel_size, Eigen::Vector3d(0.5, 0.5, 0.5));
+  EXPECT_EQ(s.Report().rfind("rendered 2 grains of frame 20 of ", 0), 0u) << s.Report();
+  const Stack back = read_stack(o.out);
+  EXPECT_EQ(back.nx, s.nx);
+  EXPECT_EQ(read_csv(o.truth, {"x", "y", "z"}).table.rows(), 2u);
+
+  o.frame = 15;
+  o.out = path("none.tif");
+  o.truth.clear();
+  EXPECT_THROW(
+      {
+        try {
+          render_run(o);
+        } catch (const Error& e) {
+          EXPECT_NE(std::string(e.what()).find("has no such frame; its frames are 10 to 20"),
+                    std::string::npos)
+              << e.what();
+          throw;
+        }
+      },
+      Error);
+  EXPECT_FALSE(std::filesystem::exists(o.out));
 }
 
 }  // namespace

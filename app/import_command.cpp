@@ -77,14 +77,7 @@ void add_import(CLI::App& app) {
     run.header.parameters = used_options(*cmd);
     write_trajectories(args->out, run);
 
-    std::cout << "imported " << summary.rows << " rows of " << args->table << " (" << summary.format
-              << "): " << summary.frames << " frames, " << summary.grains << " grains, "
-              << summary.missing << " missing (grain, frame) entries";
-    if (run.header.has_axis) std::cout << ", cavity axis in " << summary.axes_known << " rows";
-    std::cout << "\n";
-    for (const std::string& note : summary.notes)
-      std::cout << note << "\n";
-    std::cout << "lengths in " << summary.length_unit << "\nwrote " << args->out << " and "
+    std::cout << summary.Report() << "wrote " << args->out << " and "
               << xdmf_path(args->out).string() << "\n";
   });
 }

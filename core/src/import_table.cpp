@@ -260,6 +260,8 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
   }
 
   if (summary) {
+    summary->source = csv.name;
+    summary->has_axis = has_axis;
     summary->rows = rows;
     summary->frames = frames.size();
     summary->grains = n;
@@ -269,6 +271,21 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
   }
   return run;
 }
+
+}  // namespace
+
+std::string ImportSummary::Report() const {
+  std::string s = "imported " + std::to_string(rows) + " rows of " + source + " (" + format +
+                  "): " + std::to_string(frames) + " frames, " + std::to_string(grains) +
+                  " grains, " + std::to_string(missing) + " missing (grain, frame) entries";
+  if (has_axis) s += ", cavity axis in " + std::to_string(axes_known) + " rows";
+  s += "\n";
+  for (const std::string& note : notes)
+    s += note + "\n";
+  return s + "lengths in " + length_unit + "\n";
+}
+
+namespace {
 
 bool is_lammps_dump(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);

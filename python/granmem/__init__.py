@@ -148,6 +148,11 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
     return _frame(columns, units, length_unit=length_unit, summary=summary)
 
 
+def info(path):
+    """What a trajectory store holds, as ``granmem info`` prints it."""
+    return _granmem.info(os.fspath(path))
+
+
 def read_run(path):
     """A trajectory store (.h5, H5MD) as a dict of numpy arrays: position (frames, grains,
     3; NaN where not seen), axis, orientation (or None), id, radius, step, time, box,

@@ -27,6 +27,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/import_table.hpp"
 #include "granmem/core/option_values.hpp"
+#include "granmem/core/run_info.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/trajectory_table.hpp"
@@ -856,6 +857,8 @@ PYBIND11_MODULE(_granmem, m) {
     }
   });
 
+  m.def(
+      "info", [](const std::filesystem::path& path) { return run_info(path); }, py::arg("path"));
   m.def("read_stack", &read_stack_py, py::arg("path"), py::arg("dataset") = "",
         py::arg("region") = py::none());
   m.def("write_tiff", &write_tiff_py, py::arg("stack"), py::arg("path"),

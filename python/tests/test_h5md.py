@@ -163,6 +163,7 @@ def test_a_file_of_another_writer_is_read(tmp_path, cli, strings):
     np.testing.assert_array_equal(run["id"], [7, 3])
     info = cli("info", "other.h5")
     assert "otherMD 2.0" in info and "A. Nother" in info
+    assert granmem.info(tmp_path / "other.h5") == info.replace("other.h5:", str(tmp_path / "other.h5") + ":", 1)
     cli("analyze", "other.h5", "--out", "a")
     table = (tmp_path / "a" / "displacements.csv").read_text().splitlines()
     assert len([row for row in table if not row.startswith("#")]) == 1 + 2 * 2

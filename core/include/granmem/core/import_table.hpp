@@ -44,6 +44,10 @@ struct ImportSummary {
   std::string length_unit;         // unit of the stored positions
   std::string format;              // "csv" or "lammps dump"
   std::vector<std::string> notes;  // what was taken from the file, for the user
+  std::string source;              // the table's name
+  bool has_axis = false;
+  // What the command line prints: the counts, the notes, the unit.
+  std::string Report() const;
 };
 
 // Reads the table into a run: frames in increasing `frame` order (step = frame label),

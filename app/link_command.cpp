@@ -63,28 +63,14 @@ void validate(const LinkArgs& args) {
 
 void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
                     const LinkArgs& args, const std::string& out, const CLI::App& cmd) {
-  LinkRun linked = link_run(std::move(scans), names, link_run_options(args));
+  const LinkRun linked = link_run(std::move(scans), names, link_run_options(args));
   for (const std::string& note : linked.notes)
     std::cerr << "granmem: note: " << note << "\n";
-  for (const auto& [key, value] : used_options(cmd))
-    linked.run.header.parameters[key] = value;
-
-  // Everything is written under temporary names first, then renamed into place.
-  TrajectoryWriter writer(out, linked.run.header);
-  for (const Frame& frame : linked.run.frames)
-    writer.append(frame);
-  std::optional<AtomicFile> report;
-  if (!args.report.empty()) {
-    report.emplace(args.report);
-    write_csv(unlinked_table(linked), *report,
-              {"granmem link: what could not be linked, lengths in " + linked.summary.length_unit,
-               "lost=1: track seen in the scan before (at x,y,z) and not found in this frame",
-               "lost=0: detection of this frame starting a new track"});
-  }
-  writer.commit();
-  if (report) report->commit();
-  std::cout << linked.Report() << "wrote " << out << " and " << xdmf_path(out).string();
-  if (report) std::cout << " and " << args.report;
+  const std::vector<std::filesystem::path> written =
+      write_link_run(linked, out, args.report, used_options(cmd));
+  std::cout << linked.Report() << "wrote";
+  for (std::size_t k = 0; k < written.size(); ++k)
+    std::cout << (k ? (k + 1 == written.size() ? " and " : ", ") : " ") << written[k].string();
   std::cout << "\n";
 }
 

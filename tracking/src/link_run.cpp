@@ -1,11 +1,16 @@
 #include "granmem/tracking/link_run.hpp"
 
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
+#include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
+#include "granmem/core/table.hpp"
+#include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
+#include "granmem/core/xdmf.hpp"
 
 namespace granmem {
 namespace {
@@ -160,6 +165,32 @@ Table unlinked_table(const LinkRun& linked) {
     }
   }
   return t;
+}
+
+std::vector<std::filesystem::path> write_link_run(
+    const LinkRun& linked, const std::filesystem::path& out, const std::filesystem::path& report,
+    const std::map<std::string, std::string>& parameters) {
+  RunHeader header = linked.run.header;
+  for (const auto& [key, value] : parameters)
+    header.parameters[key] = value;
+  TrajectoryWriter writer(out, header);
+  for (const Frame& frame : linked.run.frames)
+    writer.append(frame);
+  std::optional<AtomicFile> table;
+  if (!report.empty()) {
+    table.emplace(report);
+    write_csv(unlinked_table(linked), *table,
+              {"granmem link: what could not be linked, lengths in " + linked.summary.length_unit,
+               "lost=1: track seen in the scan before (at x,y,z) and not found in this frame",
+               "lost=0: detection of this frame starting a new track"});
+  }
+  writer.commit();
+  std::vector<std::filesystem::path> written{out, xdmf_path(out)};
+  if (table) {
+    table->commit();
+    written.push_back(report);
+  }
+  return written;
 }
 
 }  // namespace granmem

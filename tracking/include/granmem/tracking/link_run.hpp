@@ -1,5 +1,9 @@
 #pragma once
 
+#include <map>
+
+#include <filesystem>
+
 #include <optional>
 #include <string>
 #include <vector>
@@ -54,5 +58,12 @@ LinkRun link_run(std::vector<Detections> scans, const std::vector<std::string>& 
 // scan starting a new track (lost = 0). Columns frame, particle, detection, lost, x, y, z,
 // positions in the run's frame.
 Table unlinked_table(const LinkRun& linked);
+
+// Writes the linked run as a trajectory store `out` (with its XDMF sidecar; `parameters`
+// added to the run's) and, if `report` is not empty, the unlinked table as CSV: all under
+// temporary names, renamed into place together at the end. Returns the files written.
+std::vector<std::filesystem::path> write_link_run(
+    const LinkRun& linked, const std::filesystem::path& out, const std::filesystem::path& report,
+    const std::map<std::string, std::string>& parameters);
 
 }  // namespace granmem

@@ -14,7 +14,6 @@
 #include "tracking_steps.hpp"
 
 namespace granmem::app {
-namespace {
 
 LinkRunOptions link_run_options(const LinkArgs& args) {
   LinkRunOptions o;
@@ -25,8 +24,6 @@ LinkRunOptions link_run_options(const LinkArgs& args) {
   o.container_size = args.container_size;
   return o;
 }
-
-}  // namespace
 
 void add_link_options(CLI::App* cmd, LinkArgs& args) {
   cmd->add_option("--max-displacement", args.max_displacement,

@@ -8,6 +8,7 @@
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/locate_scan.hpp"
 #include "granmem/tracking/stack.hpp"
+#include "granmem/tracking/track_run.hpp"
 #include "tracking_steps.hpp"
 
 namespace granmem::app {
@@ -49,7 +50,7 @@ void add_locate_options(CLI::App* cmd, LocateArgs& args) {
                 "skip the illumination correction (evenly lit or corrected scans)");
 }
 
-Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame) {
+ScanLocateOptions scan_locate_options(const LocateArgs& args) {
   ScanLocateOptions o;
   o.read.dataset = args.dataset;
   if (!args.region.empty()) o.read.region = parse_region(args.region, "--region");
@@ -68,6 +69,11 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
   o.locate.passes = args.passes;
   o.locate.fit_axis = args.axis == "fit";
   o.locate.correct_illumination = !args.no_illumination;
+  return o;
+}
+
+Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame) {
+  ScanLocateOptions o = scan_locate_options(args);
   o.frame = frame;
   LocatedScan s = granmem::locate_scan(path, o);
   std::cout << s.Report();
@@ -128,28 +134,30 @@ void add_track(CLI::App& app) {
     std::vector<std::string> scans = args->scans;
     std::stable_sort(scans.begin(), scans.end(), natural_less);
     // Every scan there and every output safe to write, before the first is located.
-    auto detections_of = [&](const std::string& scan) {
-      const std::filesystem::path name = std::filesystem::path(scan).filename();
-      return std::filesystem::path(args->detections) / (name.stem().string() + ".h5");
-    };
     validate(args->link);
     std::vector<NamedPath> inputs, outputs = link_outputs(args->link, args->out);
+    if (!args->detections.empty()) std::filesystem::create_directories(args->detections);
     for (const std::string& scan : scans) {
       if (!std::filesystem::exists(scan)) throw Error("scan " + scan + ": no such file or folder");
       inputs.push_back({"scan", scan});
-    }
-    if (!args->detections.empty()) {
-      std::filesystem::create_directories(args->detections);
-      for (const std::string& scan : scans)
-        outputs.push_back({"--detections of " + scan, detections_of(scan)});
+      if (!args->detections.empty()) {
+        outputs.push_back({"--detections of " + scan, detections_path(args->detections, scan)});
+      }
     }
     check_outputs(outputs, inputs);
-    std::vector<Detections> found;
-    for (std::size_t k = 0; k < scans.size(); ++k) {
-      found.push_back(locate_scan(scans[k], args->locate, std::int64_t(k)));
-      if (!args->detections.empty()) write_detections(found.back(), detections_of(scans[k]));
-    }
-    link_and_write(std::move(found), scans, args->link, args->out, *cmd);
+    TrackRunOptions options;
+    options.scans.assign(scans.begin(), scans.end());
+    options.locate = scan_locate_options(args->locate);
+    options.detections = args->detections;
+    options.link = link_run_options(args->link);
+    options.out = args->out;
+    options.report = args->link.report;
+    options.parameters = used_options(*cmd);
+    options.log = [](const std::string& line) { std::cout << line << std::flush; };
+    const TrackSummary tracked = track_run(options);
+    for (const std::string& note : tracked.linked.notes)
+      std::cerr << "granmem: note: " << note << "\n";
+    std::cout << tracked.Report();
     if (!args->analyze.empty()) {
       AnalysisOptions options;
       options.motion.hole_contacts = HoleContactPolicy::exclude_rotations;  // the paper's choice

@@ -7,7 +7,9 @@
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/tracking/detections.hpp"
+#include "granmem/tracking/link_run.hpp"
 #include "granmem/tracking/locate.hpp"
+#include "granmem/tracking/locate_scan.hpp"
 
 // The two steps of the experimental pipeline as the commands run them: `locate` and
 // `link` each run one, `track` both.
@@ -20,6 +22,8 @@ struct LocateArgs {
   bool no_illumination = false;
 };
 void add_locate_options(CLI::App* cmd, LocateArgs& args);
+// The library's options from the flags.
+ScanLocateOptions scan_locate_options(const LocateArgs& args);
 // Reads the stack at `path`, locates its grains (printing a line of what it found) and
 // labels them scan `frame`.
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame);
@@ -30,6 +34,7 @@ struct LinkArgs {
   bool no_drift = false;
 };
 void add_link_options(CLI::App* cmd, LinkArgs& args);
+LinkRunOptions link_run_options(const LinkArgs& args);
 // Checks what can be checked before any scan is read (--container's form and unit).
 void validate(const LinkArgs& args);
 // The files linking writes: the store `out`, its XDMF and the --report.

@@ -487,13 +487,14 @@ void write_table(hid_t loc, const std::string& group, const Table& table) {
   const std::vector<hsize_t> dims{table.rows()};
   for (const Column& c : table.columns()) {
     order.push_back(c.name);
+    const std::string unit = c.unit.empty() ? "1" : c.unit;  // dimensionless, said so
     if (c.integer) {
       std::vector<std::int64_t> ints(c.values.size());
       std::transform(c.values.begin(), c.values.end(), ints.begin(),
                      [](double v) { return static_cast<std::int64_t>(v); });
-      write(g.get(), c.name, ints.data(), dims, c.unit.empty() ? "1" : c.unit);
+      write(g.get(), c.name, ints.data(), dims, unit);
     } else {
-      write(g.get(), c.name, c.values.data(), dims, c.unit.empty() ? "1" : c.unit);
+      write(g.get(), c.name, c.values.data(), dims, unit);
     }
   }
   write_attribute(g.get(), "columns", order);

@@ -24,8 +24,12 @@ bool is_h5md_unit(const std::string& unit) {
 std::string h5md_unit(const std::string& unit) {
   return is_h5md_unit(unit) ? unit : std::string();
 }
+// A unit only granmem has (voxel, cycle): it goes in `granmem_unit`.
+bool is_granmem_only_unit(const std::string& unit) {
+  return !unit.empty() && unit != "1" && !is_h5md_unit(unit);
+}
 void mark_granmem_unit(hid_t obj, const std::string& unit) {
-  if (!unit.empty() && unit != "1" && !is_h5md_unit(unit)) {
+  if (is_granmem_only_unit(unit)) {
     h5::write_attribute(obj, "granmem_unit", unit);
   }
 }
@@ -33,7 +37,7 @@ template <class T>
 void write_with_unit(hid_t loc, const std::string& name, const T* data,
                      const std::vector<hsize_t>& dims, const std::string& unit) {
   h5::write(loc, name, data, dims, h5md_unit(unit));
-  if (!is_h5md_unit(unit) && unit != "1" && !unit.empty()) {
+  if (is_granmem_only_unit(unit)) {
     const h5::Handle set(H5Dopen2(loc, name.c_str(), H5P_DEFAULT), H5Dclose);
     mark_granmem_unit(set.get(), unit);
   }

@@ -33,6 +33,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/deposit.hpp"
+#include "granmem/sim/lammps_data.hpp"
 #include "granmem/sim/quasi_static.hpp"
 #include "granmem/sim/simulation.hpp"
 #include "granmem/sim/spatial_order.hpp"
@@ -86,46 +87,14 @@ granmem::DepositOptions deposit_options(long grains, double box_cm, long seed) {
   return d;
 }
 
-// A LAMMPS data file (atom_style sphere, CGS): grains are type 1 with ids id + 1; the lid,
-// when present, is type 2, a point particle (diameter 0: its "density" column is its mass)
-// at the middle of the box at the height of its lower face, id N + 1. Box: x, y from 0 to
-// the box sides, z from -0.5 cm to well above the highest grain.
+// The packing as LAMMPS reads it (sim/lammps/common.lmp): atom_style sphere, the lid a
+// type-2 point particle.
 void write_lammps_data(const std::filesystem::path& path, const Grains& g, const Container& c,
                        double density, const std::string& comment) {
-  std::ofstream out(path);
-  if (!out) throw granmem::Error("cannot write " + path.string());
-  out << std::setprecision(17);
-  double top = 0;
-  for (std::size_t i = 0; i < g.size(); ++i)
-    top = std::max(top, g.x[i].z() + g.radius[i]);
-  if (c.lid.present) top = std::max(top, c.lid.z);
-  const double lx = c.size.x() / kCm, ly = c.size.y() / kCm;
-  const double zhi = std::max(4.0 * ly, 2.0 * top / kCm + 1.0);
-  const std::size_t n = g.size(), atoms = n + (c.lid.present ? 1 : 0);
-  out << "LAMMPS data file (CGS) from granmem dem_bench: " << comment << "\n\n"
-      << atoms << " atoms\n2 atom types\n\n"
-      << std::setprecision(12) << 0.0 << " " << lx << " xlo xhi\n"
-      << 0.0 << " " << ly << " ylo yhi\n"
-      << -0.5 << " " << zhi << " zlo zhi\n\nAtoms # sphere\n\n"
-      << std::setprecision(17);
-  const double rho_cgs = density * 1e-3;  // kg/m^3 -> g/cm^3
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d x = g.x[i] / kCm;
-    out << g.id[i] + 1 << " 1 " << 2 * g.radius[i] / kCm << " " << rho_cgs << " " << x.x() << " "
-        << x.y() << " " << x.z() << "\n";
-  }
-  if (c.lid.present) {
-    out << n + 1 << " 2 0 " << c.lid.mass * 1e3 << " " << 0.5 * lx << " " << 0.5 * ly << " "
-        << c.lid.z / kCm << "\n";
-  }
-  out << "\nVelocities\n\n";
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d v = g.v[i] / kCm;
-    out << g.id[i] + 1 << " " << v.x() << " " << v.y() << " " << v.z() << " " << g.w[i].x() << " "
-        << g.w[i].y() << " " << g.w[i].z() << "\n";
-  }
-  if (c.lid.present) out << n + 1 << " 0 0 " << c.lid.v / kCm << " 0 0 0\n";
-  if (!out) throw granmem::Error("error writing " + path.string());
+  granmem::LammpsDataOptions o;
+  o.density = density;
+  o.comment = "dem_bench: " + comment;
+  granmem::write_lammps_data(path, g, c, o);
 }
 
 int insert(const std::vector<std::string>& a) {

@@ -14,6 +14,7 @@
 # 5 cycles per run). Each run deposits its own packing from its seed, so the runs of one
 # (mu_s, seed) start from the same packing, bit for bit. Progress: DIR/<run>.log.
 set -euo pipefail
+source "$(dirname "$0")/lib/resumable_run.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out/quasistatic"
@@ -46,24 +47,8 @@ case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 # One run: finished (a .done marker), resumed from its checkpoint, or started.
 run_one() {
   local name=$1 mu=$2 seed=$3 inertial=$4
-  local h5="$out/$name.h5" ckpt="$out/$name.checkpoint.h5" log="$out/$name.log"
-  [[ -e $out/$name.done ]] && return 0
-  local args
-  if [[ -s $ckpt ]]; then
-    args=(--resume "$ckpt" --cycles "$cycles")
-  else
-    rm -f "$h5"
-    args=(--grains "$grains" --box 5cm --lid-mass 0.1111kg --amplitude 1% --mu-s "$mu"
-          --seed "$seed" --inertial-number "$inertial" --cycles "$cycles"
-          --checkpoint-every 5 --out "$h5" --checkpoint "$ckpt")
-  fi
-  if OMP_NUM_THREADS=1 "$granmem" simulate --threads 1 "${args[@]}" >> "$log" 2>&1; then
-    touch "$out/$name.done"
-    echo "done: $name"
-  else
-    echo "failed or stopped: $name (see $log)" >&2
-    return 1
-  fi
+  resumable_run "$out" "$name" "$cycles" --grains "$grains" --box 5cm --lid-mass 0.1111kg \
+    --amplitude 1% --mu-s "$mu" --seed "$seed" --inertial-number "$inertial" --checkpoint-every 5
 }
 export -f run_one
 export out cycles grains granmem

@@ -93,9 +93,9 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kTargets{
     {"y", {"y", "yu", "ys", "ysu"}},
     {"z", {"z", "zu", "zs", "zsu"}},
     {"radius", {"radius", "diameter"}},
-    {"ax", {"ax"}},
-    {"ay", {"ay"}},
-    {"az", {"az"}},
+    {"ax", {"ax", "mux"}},  // a dipole carried with the grain (sim/lammps/cycles.lmp)
+    {"ay", {"ay", "muy"}},
+    {"az", {"az", "muz"}},
     {"qw", {"quatw", "qw"}},
     {"qx", {"quati", "qx"}},
     {"qy", {"quatj", "qy"}},

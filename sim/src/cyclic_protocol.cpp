@@ -44,8 +44,11 @@ constexpr const char* kInCycle = "in_cycle";
 // Most steps run between two looks at the stop flag and the progress clock.
 constexpr std::int64_t kStepsPerRun = 256;
 
-RunHeader header_for(const Simulation& sim, const std::vector<std::size_t>& grains,
-                     const char* sample, const std::map<std::string, std::string>& parameters) {
+}  // namespace
+
+RunHeader cyclic_run_header(const Simulation& sim, const std::vector<std::size_t>& grains,
+                            const char* sample,
+                            const std::map<std::string, std::string>& parameters) {
   RunHeader h;
   h.length_unit = "m";
   h.time_unit = "s";
@@ -62,6 +65,8 @@ RunHeader header_for(const Simulation& sim, const std::vector<std::size_t>& grai
   h.parameters = parameters;
   return h;
 }
+
+namespace {
 
 Frame frame_of(const Simulation& sim, const RunHeader& h, const std::vector<std::size_t>& grains,
                std::int64_t step) {
@@ -192,7 +197,7 @@ class CycleRunner {
     Output& out = outputs_[kind];
     out.grains = grains;
     if (fresh_) {
-      out.header = header_for(sim_, grains, kind, o_.parameters);
+      out.header = cyclic_run_header(sim_, grains, kind, o_.parameters);
       out.writer = std::make_unique<TrajectoryWriter>(path, out.header);
       state_.frames_written[kind] = 0;
       return;

@@ -11,6 +11,7 @@
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/sim/checkpoint.hpp"
+#include "granmem/sim/lammps_engine.hpp"
 #include "granmem/sim/quasi_static.hpp"
 
 namespace granmem {
@@ -30,8 +31,8 @@ Start start_of(const SimulateOptions& o, const std::function<void(const std::str
   if (!o.resume.empty()) {
     s.sim.emplace(read_checkpoint(o.resume, &s.state));
     // The run goes on with the settings it started with; more cycles may be asked for.
-    s.settings =
-        resumed_settings(s.state.settings, o.settings, o.given, {"checkpoint-every", "cycles"});
+    s.settings = resumed_settings(s.state.settings, o.settings, o.given,
+                                  {"checkpoint-every", "cycles", "ranks", "lammps"});
     log("resuming " + o.resume + " after cycle " + std::to_string(s.state.cycles_done) +
         (s.state.step_in_cycle ? " (+" + std::to_string(s.state.step_in_cycle) + " steps)"
                                : std::string()));
@@ -113,6 +114,25 @@ CyclicOptions protocol_of(RunSettings& v, const PhysicsOptions& physics, const D
   return c;
 }
 
+// --engine lammps: where and how LAMMPS runs, checked with what it cannot run.
+std::optional<LammpsEngineOptions> lammps_engine_from(const RunSettings& v, const CyclicOptions& c,
+                                                      const DepositOptions& d,
+                                                      const std::optional<Simulation>& sim,
+                                                      bool resume) {
+  const std::string& engine = v.at("engine");
+  if (engine == "granmem") return std::nullopt;
+  if (engine != "lammps") throw Error("--engine " + engine + ": expected granmem or lammps");
+  LammpsEngineOptions e;
+  e.folder = lammps_folder(c.out);
+  e.ranks = int(std::min<std::int64_t>(setting_whole(v, "ranks"), 1 << 20));
+  e.lmp = v.at("lammps");
+  e.resume = resume;
+  e.validate();
+  const bool lid = sim ? sim->container().lid.present : d.lid_mass > 0;
+  check_lammps_protocol(c, sim ? true : d.polydispersity == 0, lid);  // sizes: checked on the run
+  return e;
+}
+
 std::string deposited_text(const DepositSummary& s, const DepositOptions& d,
                            const PhysicsOptions& physics) {
   std::ostringstream t;
@@ -140,6 +160,8 @@ SimulateSummary simulate(const SimulateOptions& o) {
   // Every setting is checked before the packing is made.
   CyclicOptions c = protocol_of(v, physics, d, start.sim);
   check_run_outputs(c, o.start_from);
+  const std::optional<LammpsEngineOptions> lammps =
+      lammps_engine_from(v, c, d, start.sim, !o.resume.empty());
 
   if (!start.sim) {
     log("depositing " + std::to_string(d.grains) + " grains (seed " + std::to_string(d.seed) + ")");
@@ -161,7 +183,16 @@ SimulateSummary simulate(const SimulateOptions& o) {
 
   if (o.cycles_start) o.cycles_start();
   SimulateSummary summary;
-  summary.cycles = run_cycles(sim, c, start.state, o.progress, o.stop);
+  if (lammps) {
+    // The packing before the first cycle is the checkpoint: --resume reads it and LAMMPS
+    // goes on from its newest restart.
+    if (o.resume.empty()) write_checkpoint(c.checkpoint, sim, start.state);
+    log("running the cycles on LAMMPS in " + lammps->folder.string() + " (" +
+        std::to_string(lammps->ranks) + (lammps->ranks > 1 ? " ranks)" : " rank)"));
+    summary.cycles = run_cycles_on_lammps(sim, c, *lammps, o.progress, o.stop);
+  } else {
+    summary.cycles = run_cycles(sim, c, start.state, o.progress, o.stop);
+  }
   summary.settings = v;
   summary.grains = sim.grains().size();
   summary.checkpoint = c.checkpoint;

@@ -56,6 +56,11 @@ const OptionSpec kSimulateOptions[] = {
      "trained states for granmem readout"},
     {"checkpoint", "", "checkpoint file (default <out>.checkpoint.h5)"},
     {"out", "run.h5", "end-of-cycle trajectory store"},
+    {"engine", "granmem",
+     "what runs the cycles: granmem (the embedded DEM) or lammps (LAMMPS under mpirun, files "
+     "in <out>.lammps/; equal grains, end-of-cycle frames, cavity axes only)"},
+    {"ranks", "1", "--engine lammps: MPI ranks (mpirun -np)"},
+    {"lammps", "lmp", "--engine lammps: the LAMMPS executable"},
 };
 const std::size_t kSimulateOptionCount = std::size(kSimulateOptions);
 

@@ -200,5 +200,68 @@ TEST_F(Interruption, AKilledReadoutSweepReusesItsFinishedRunsAndEndsTheSame) {
   EXPECT_TRUE(left.empty()) << left.front();
 }
 
+// The protocol on LAMMPS stopped (Ctrl-C, SIGTERM): LAMMPS is ended with granmem, the
+// frames up to its newest restart are those of a run never stopped, bit for bit, and
+// --resume goes on from that restart to every cycle. LAMMPS's own restart is not bit for
+// bit (it rebuilds its neighbour lists), so later frames agree as two runs of one packing
+// do over a few cycles.
+TEST_F(Interruption, AStoppedLammpsRunResumesFromItsNewestRestart) {
+#ifndef GRANMEM_LAMMPS_EXE
+  GTEST_SKIP() << "no lmp when the build was configured (Debian's lammps)";
+#else
+  auto run = [](const std::string& out) {
+    return std::vector<std::string>{"simulate",
+                                    "--grains",
+                                    "150",
+                                    "--box",
+                                    "2.5cm",
+                                    "--cycles",
+                                    "8",
+                                    "--checkpoint-every",
+                                    "2",
+                                    "--engine",
+                                    "lammps",
+                                    "--lammps",
+                                    GRANMEM_LAMMPS_EXE,
+                                    "--out",
+                                    out};
+  };
+  granmem_ok(run("whole.h5"));
+  for (int signal : {SIGINT, SIGTERM}) {
+    SCOPED_TRACE(strsignal(signal));
+    const std::string out = signal == SIGINT ? "interrupted.h5" : "termed.h5";
+    const std::string stem = fs::path(out).stem().string();
+    const pid_t child = start(run(out));
+    ASSERT_TRUE(wait_for(child, stem + ".lammps/cycle2.restart")) << "no restart after cycle 2";
+    kill(child, signal);
+    EXPECT_EQ(wait_exit(child), 128 + signal);
+    const std::string err = testing::read_file(dir_ / "capture" / "started.err");
+    EXPECT_NE(err.find("stopped after cycle"), std::string::npos) << err;
+    const RunResult resumed = granmem_ok({"simulate", "--resume", stem + ".checkpoint.h5"});
+    const Trajectories a = read_trajectories(in_work("whole.h5"));
+    const Trajectories b = read_trajectories(in_work(out));
+    ASSERT_EQ(b.frames.size(), 9u);
+    for (std::size_t t = 0; t <= 2; ++t) {
+      EXPECT_EQ((a.frames[t].position - b.frames[t].position).cwiseAbs().maxCoeff(), 0.0)
+          << "frame " << t;
+    }
+    const double whole_path = (a.frames[8].position - a.frames[0].position).rowwise().norm().mean();
+    const double resumed_path =
+        (b.frames[8].position - b.frames[0].position).rowwise().norm().mean();
+    EXPECT_NEAR(resumed_path / whole_path, 1.0, 0.1);
+    // One restart is left, the newest, and nothing half-written.
+    std::vector<std::string> restarts, partial;
+    for (const auto& e : fs::directory_iterator(in_work(stem + ".lammps"))) {
+      const std::string name = e.path().filename().string();
+      if (e.path().extension() == ".restart") restarts.push_back(name);
+      if (e.path().extension() == ".part") partial.push_back(name);
+    }
+    EXPECT_EQ(restarts, std::vector<std::string>{"cycle8.restart"});
+    EXPECT_TRUE(partial.empty()) << partial.front();
+    EXPECT_TRUE(temporaries().empty()) << temporaries().front();
+  }
+#endif
+}
+
 }  // namespace
 }  // namespace granmem

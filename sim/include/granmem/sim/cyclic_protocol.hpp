@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "granmem/core/trajectories.hpp"
 #include "granmem/sim/checkpoint.hpp"
 #include "granmem/sim/simulation.hpp"
 #include "granmem/sim/wall_drive.hpp"
@@ -60,6 +61,12 @@ std::filesystem::path in_cycle_path(const std::filesystem::path& out);
 // stopped go on without running its finished runs again. Error for a file it cannot read.
 bool finished_run(const std::filesystem::path& out,
                   const std::map<std::string, std::string>& parameters, std::int64_t cycles);
+
+// The header of a store of these grains (indices) of `sim`: ids, radii, the box up to the
+// packing's top, positions in m and time in s, axes and orientations.
+RunHeader cyclic_run_header(const Simulation& sim, const std::vector<std::size_t>& grains,
+                            const char* sample,
+                            const std::map<std::string, std::string>& parameters);
 
 // <out stem>_state_cycle<cycle>.h5
 std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle);

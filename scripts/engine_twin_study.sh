@@ -8,6 +8,7 @@
 #
 #   scripts/engine_twin_study.sh [--out DIR] [--report DIR] [--jobs J] [--cycles C]
 #                                [--window A:B] [--seeds "1 2 3"] [--grains N] [--ranks R]
+#                                [--granmem BIN]
 #
 # Runs J simulations at a time (default 2; LAMMPS runs take R ranks each, default 1), each
 # with a checkpoint (granmem) or a restart (LAMMPS) every 5 cycles: calling the script
@@ -37,7 +38,8 @@ while [[ $# -gt 0 ]]; do
     --seeds) seeds="$2"; shift ;;
     --grains) grains="$2"; shift ;;
     --ranks) ranks="$2"; shift ;;
-    -h|--help) sed -n '2,16p' "$0"; exit 0 ;;
+    --granmem) granmem="$2"; shift ;;
+    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
     *) echo "engine_twin_study.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift

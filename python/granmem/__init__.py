@@ -232,9 +232,10 @@ def analyze(run, subtract_drift=False, wall_distance=0, container=None, hole_con
 
 def simulate(out=None, resume=None, start_from=None, threads=0, progress=None,
              **settings):
-    """The embedded DEM, as ``granmem simulate``: grains deposited under a lid (or a packing
-    from ``start_from``'s checkpoint) and compressed cyclically; the end-of-cycle store at
-    ``out`` (read it with ``read_run`` or ``analyze``) and a checkpoint beside it.
+    """The embedded DEM (or LAMMPS, ``engine="lammps"``: docs/LAMMPS.md), as ``granmem
+    simulate``: grains deposited under a lid (or a packing from ``start_from``'s
+    checkpoint) and compressed cyclically; the end-of-cycle store at ``out`` (read it with
+    ``read_run`` or ``analyze``) and a checkpoint beside it.
 
     ``settings``: simulate's options with ``_`` for ``-`` and their units as text, e.g.
     ``grains=1500, box="5cm", lid_pressure="436Pa", amplitude="1%", mu_s=0.15, cycles=40``

@@ -1,4 +1,6 @@
 """granmem.simulate: the command line's run from Python, interrupted and resumed."""
+import shutil
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -75,6 +77,25 @@ def test_ctrl_c_stops_with_a_checkpoint(tmp_path):
     resumed = granmem.simulate(resume=tmp_path / "run.checkpoint.h5", cycles=frames + 1,
                                threads=1)
     assert resumed["cycles_done"] == frames + 1
+
+
+@pytest.mark.skipif(shutil.which("lmp") is None, reason="no lmp (Debian's lammps)")
+def test_the_protocol_runs_on_lammps_from_python(tmp_path):
+    # The same settings, engine="lammps": granmem's deposit cycled by LAMMPS, read back as
+    # a store with cavity axes and no orientations; the lid where the embedded DEM has it.
+    small = dict(grains=150, box="2.5cm", cycles=1, threads=1)
+    lines = []
+    summary = granmem.simulate(out=tmp_path / "lmp.h5", engine="lammps",
+                               progress=lambda r: lines.append(r.get("line", "")), **small)
+    assert summary["cycles_done"] == 1 and summary["settings"]["engine"] == "lammps"
+    assert any(line.startswith("running the cycles on LAMMPS") for line in lines)
+    granmem.simulate(out=tmp_path / "dem.h5", **small)
+    lmp, dem = granmem.read_run(tmp_path / "lmp.h5"), granmem.read_run(tmp_path / "dem.h5")
+    assert lmp["orientation"] is None and lmp["axis"].shape == (2, 150, 3)
+    np.testing.assert_allclose(np.linalg.norm(lmp["axis"], axis=2), 1.0, atol=1e-12)
+    np.testing.assert_allclose(lmp["position"][0], dem["position"][0], atol=1e-12)
+    lid = lmp["observables"]["lid_height"]["value"], dem["observables"]["lid_height"]["value"]
+    np.testing.assert_allclose(lid[0], lid[1], rtol=1e-3)
 
 
 def test_readout_in_python_equals_the_command_line(tmp_path, cli):

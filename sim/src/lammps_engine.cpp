@@ -136,6 +136,7 @@ pid_t launch(const LammpsEngineOptions& e) {
     execvp(argv[0], argv.data());
     _exit(127);
   }
+  setpgid(pid, pid);  // as the child does: whichever runs first, the group exists for kill
   return pid;
 }
 
@@ -170,6 +171,23 @@ std::map<std::int64_t, std::array<double, 5>> read_observed(const std::filesyste
   return rows;
 }
 
+// Ends LAMMPS (and mpirun's ranks): SIGTERM to its group, SIGKILL if it has not ended
+// within 10 s.
+void end_process_group(pid_t pid) {
+  if (kill(-pid, SIGTERM) != 0) kill(pid, SIGTERM);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  int status = 0;
+  while (waitpid(pid, &status, WNOHANG) != pid) {
+    if (std::chrono::steady_clock::now() > give_up) {
+      kill(-pid, SIGKILL);
+      kill(pid, SIGKILL);
+      waitpid(pid, &status, 0);
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
 // Polls LAMMPS until it ends (its exit status) or `stop` is set (-1 after ending it),
 // reporting the cycles done as its per-cycle lines appear.
 int wait_for(pid_t pid, const std::filesystem::path& observed, std::int64_t first,
@@ -185,8 +203,7 @@ int wait_for(pid_t pid, const std::filesystem::path& observed, std::int64_t firs
       return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     }
     if (stop && stop->load()) {
-      kill(-pid, SIGTERM);
-      waitpid(pid, &status, 0);
+      end_process_group(pid);
       return -1;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -355,6 +372,11 @@ CyclicSummary run_cycles_on_lammps(const Simulation& sim, const CyclicOptions& o
 
   const auto start = std::chrono::steady_clock::now();
   CyclicSummary summary;
+  if (stop && stop->load()) {  // stopped while the packing was made
+    summary.interrupted = true;
+    summary.cycles_done = plan.first;
+    return summary;
+  }
   if (plan.first < o.cycles) {
     const int status = wait_for(launch(e), e.folder / kObserved, plan.first, o.cycles,
                                 sim.grains().size(), plan.steps_per_cycle, progress, stop);

@@ -14,9 +14,12 @@
 # with a checkpoint (granmem) or a restart (LAMMPS) every 5 cycles: calling the script
 # again with the same DIR skips finished runs and resumes the others. Progress:
 # DIR/<run>.log. Then writes DIR/../report (--report; default docs/data/engine_twin):
-# twin.csv (one row per compared pair) and the compare figures of seed 1.
+# twin.csv (one row per compared pair), observables.csv (each run's packing fraction,
+# force on the driven wall at full compression and contacts per grain, before the first
+# cycle and as means over the window) and the compare figures of seed 1.
 set -euo pipefail
 source "$(dirname "$0")/lib/resumable_run.sh"
+source "$(dirname "$0")/lib/run_tables.sh"
 
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out/engine_twin"
@@ -39,7 +42,7 @@ while [[ $# -gt 0 ]]; do
     --grains) grains="$2"; shift ;;
     --ranks) ranks="$2"; shift ;;
     --granmem) granmem="$2"; shift ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0"; exit 0 ;;
     *) echo "engine_twin_study.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -74,7 +77,7 @@ compare() {  # a b
   mkdir -p "$out/compare"
   [[ -s $dir/distances.csv ]] ||
     "$granmem" compare "$out/$1.h5" "$out/$2.h5" --window "$window" --wall-distance 5mm \
-      --label-a "$1" --label-b "$2" --out "$dir" > "$dir.log" 2>&1
+      --label-a "${1//_/ }" --label-b "${2//_/ }" --out "$dir" > "$dir.log" 2>&1
   # quantity (1 = dr, 2 = rot_disp): mean_a mean_b ks ks_p
   for q in 1 2; do
     awk -F, -v q="$q" -v a="$1" -v b="$2" -v kind="$3" '!/^#/ && $1 == q {
@@ -99,9 +102,24 @@ table="$report/twin.csv"
   done
 } > "$table.tmp"
 mv "$table.tmp" "$table"
+# ---- the runs' own observables: before the first cycle, and means over the window
+observables="$report/observables.csv"
+{
+  echo "# engine twin study: each run's observables before the first cycle (_0) and as means over cycles $window"
+  echo "engine,seed,packing_fraction_0,packing_fraction,wall_force_full_compression_N,contacts_per_grain"
+  for e in granmem lammps; do
+    for s in $seeds; do
+      f="$out/${e}_seed$s.h5"
+      mean() { observable "$f" "$1" | awk -v a="${window%%:*}" -v b="${window##*:}" \
+        'NR - 1 >= a && NR - 1 <= b { s += $1; n++ } END { printf "%.6g", s / n }'; }
+      echo "$e,$s,$(observable "$f" packing_fraction | head -1),$(mean packing_fraction),$(mean wall_force_full_compression),$(mean contacts_per_grain)"
+    done
+  done
+} > "$observables.tmp"
+mv "$observables.tmp" "$observables"
 first=$(echo "$seeds" | awk '{print $1}')
 for f in "$out/compare/granmem_seed$first-vs-lammps_seed$first"/*.png; do
   [[ -e $f ]] && cp "$f" "$report/"
 done
-echo "wrote $table"
+echo "wrote $table and $observables"
 column -s, -t < <(grep -v '^#' "$table")

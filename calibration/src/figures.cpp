@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <string_view>
 
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
@@ -28,6 +29,17 @@ std::string quoted(const std::string& text) {
     q += c;
   }
   return q + "\"";
+}
+
+// A name given by the user (a run's label, a file's stem) as gnuplot's enhanced text shows
+// it: its _ ^ @ & ~ { } as themselves, not as sub- and superscripts.
+std::string plain(const std::string& text) {
+  std::string p;
+  for (char c : text) {
+    if (std::string_view("_^@&~{}").find(c) != std::string_view::npos) p += '\\';
+    p += c;
+  }
+  return p;
 }
 
 // Writes the data and the script (whose `plot` part is `body`, data in `<name>.dat`), runs
@@ -125,7 +137,7 @@ std::vector<fs::path> plot_log_pdfs(const fs::path& dir, const std::string& name
     data << "\n\n";
     plot << (k ? ", " : "") << quoted(name + ".dat") << " index " << k
          << " using 1:2 with linespoints pt " << marks[k % 6] << " title "
-         << quoted(samples[k].label);
+         << quoted(plain(samples[k].label));
   }
   plot << "\n";
   return draw(dir, name, data.str(), plot.str());
@@ -149,7 +161,7 @@ std::vector<fs::path> plot_relaxation(const fs::path& dir, const std::string& na
     }
     data << "\n\n";
     char label[160];
-    std::snprintf(label, sizeof label, "%s: n^{-%.2f [%.2f, %.2f]}", r.label.c_str(),
+    std::snprintf(label, sizeof label, "%s: n^{-%.2f [%.2f, %.2f]}", plain(r.label).c_str(),
                   r.fit.exponent, r.fit.exponent_ci95[0], r.fit.exponent_ci95[1]);
     fits << ", " << r.fit.amplitude << " * x**(-" << r.fit.exponent << ") with lines dt 2 lc "
          << k + 1 << " lw 2 title " << quoted(label);
@@ -158,7 +170,7 @@ std::vector<fs::path> plot_relaxation(const fs::path& dir, const std::string& na
   for (std::size_t k = 0; k < runs.size(); ++k) {
     plot << (k ? ", " : "") << quoted(name + ".dat") << " index " << k
          << " using 1:2 with points pt " << marks[k % 4] << " lc " << k + 1 << " title "
-         << quoted(runs[k].label);
+         << quoted(plain(runs[k].label));
   }
   plot << fits.str() << "\n";
   return draw(dir, name, data.str(), plot.str());

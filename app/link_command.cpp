@@ -54,10 +54,6 @@ std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out
   return outputs;
 }
 
-void validate(const LinkArgs& args) {
-  link_run_options(args).validate();
-}
-
 void link_and_write(std::vector<Detections> scans, const std::vector<std::string>& names,
                     const LinkArgs& args, const std::string& out, const CLI::App& cmd) {
   const LinkRun linked = link_run(std::move(scans), names, link_run_options(args));
@@ -89,7 +85,7 @@ void add_link(CLI::App& app) {
     std::vector<NamedPath> inputs;
     for (const std::string& path : args->scans)
       inputs.push_back({"scan", path});
-    validate(args->link);
+    link_run_options(args->link).validate();
     check_outputs(link_outputs(args->link, args->out), inputs);
     std::vector<Detections> scans;
     scans.reserve(args->scans.size());

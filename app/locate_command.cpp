@@ -133,18 +133,6 @@ void add_track(CLI::App& app) {
   cmd->callback([args, cmd] {
     std::vector<std::string> scans = args->scans;
     std::stable_sort(scans.begin(), scans.end(), natural_less);
-    // Every scan there and every output safe to write, before the first is located.
-    validate(args->link);
-    std::vector<NamedPath> inputs, outputs = link_outputs(args->link, args->out);
-    if (!args->detections.empty()) std::filesystem::create_directories(args->detections);
-    for (const std::string& scan : scans) {
-      if (!std::filesystem::exists(scan)) throw Error("scan " + scan + ": no such file or folder");
-      inputs.push_back({"scan", scan});
-      if (!args->detections.empty()) {
-        outputs.push_back({"--detections of " + scan, detections_path(args->detections, scan)});
-      }
-    }
-    check_outputs(outputs, inputs);
     TrackRunOptions options;
     options.scans.assign(scans.begin(), scans.end());
     options.locate = scan_locate_options(args->locate);
@@ -154,6 +142,18 @@ void add_track(CLI::App& app) {
     options.report = args->link.report;
     options.parameters = used_options(*cmd);
     options.log = [](const std::string& line) { std::cout << line << std::flush; };
+    // Every option good, every scan there and every output safe to write, before the first
+    // is located.
+    options.validate();
+    std::vector<NamedPath> inputs, outputs = link_outputs(args->link, args->out);
+    if (!args->detections.empty()) std::filesystem::create_directories(args->detections);
+    for (const std::string& scan : scans) {
+      inputs.push_back({"scan", scan});
+      if (!args->detections.empty()) {
+        outputs.push_back({"--detections of " + scan, detections_path(args->detections, scan)});
+      }
+    }
+    check_outputs(outputs, inputs);
     const TrackSummary tracked = track_run(options);
     for (const std::string& note : tracked.linked.notes)
       std::cerr << "granmem: note: " << note << "\n";

@@ -35,8 +35,6 @@ struct LinkArgs {
 };
 void add_link_options(CLI::App* cmd, LinkArgs& args);
 LinkRunOptions link_run_options(const LinkArgs& args);
-// Checks what can be checked before any scan is read (--container's form and unit).
-void validate(const LinkArgs& args);
 // The files linking writes: the store `out`, its XDMF and the --report.
 std::vector<NamedPath> link_outputs(const LinkArgs& args, const std::string& out);
 // Links the scans (`names` for messages), writes the trajectory store `out` with `cmd`'s

@@ -192,7 +192,22 @@ std::string Comparison::Report() const {
   return report_;
 }
 
+void CompareOptions::validate() const {
+  if (window && window->first > window->second) {
+    throw Error("window " + std::to_string(window->first) + ":" + std::to_string(window->second) +
+                ": the first cycle is after the last");
+  }
+  if (diameter && !(*diameter > 0 && std::isfinite(*diameter))) {
+    throw Error("--diameter: expected a positive length");
+  }
+  MotionOptions motion;
+  motion.wall_distance = wall_distance;
+  motion.validate();
+  if (dir.empty()) throw Error("compare: no output folder (--out)");
+}
+
 Comparison compare(const TrajectoryReader& a, const TrajectoryReader& b, const CompareOptions& o) {
+  o.validate();
   ObservableOptions observe;
   observe.motion.subtract_drift = o.subtract_drift;
   observe.motion.wall_distance = o.wall_distance;

@@ -231,8 +231,14 @@ Table signature_table(const std::vector<StateSignature>& signatures) {
   return t;
 }
 
+void ReadoutOptions::validate() const {
+  sweep.validate();
+  motion.validate();
+}
+
 ReadoutSummary readout(const ReadoutOptions& o,
                        const std::function<void(const ReadoutSweepProgress&)>& progress) {
+  o.validate();
   ReadoutSummary s;
   s.sweep = run_readout_sweep(o.sweep, progress);
   if (!mpi_ranks().root()) return s;  // in an MPI job, rank 0 reads every run and writes

@@ -15,6 +15,27 @@
 #include "granmem/core/units.hpp"
 
 namespace granmem {
+
+void ImportOptions::validate() const {
+  if (!is_length_unit(length_unit)) {
+    throw Error("--length-unit '" + length_unit + "': expected one of m, cm, mm, um, voxel");
+  }
+  if (voxel_size) {
+    if (length_unit != "voxel") {
+      throw Error("--voxel-size applies to voxel coordinates, but --length-unit is " + length_unit);
+    }
+    if (!is_physical_length_unit(voxel_size_unit)) {
+      throw Error("--voxel-size needs a length unit (m, cm, mm or um), e.g. 0.05,0.05,0.075mm");
+    }
+    if (!(voxel_size->array() > 0).all() || !voxel_size->allFinite()) {
+      throw Error("--voxel-size: expected three positive sizes");
+    }
+  }
+  if (radius && !(*radius > 0 && std::isfinite(*radius))) {
+    throw Error("--radius: expected a positive radius");
+  }
+}
+
 namespace {
 
 // Where the rows come from, for messages: a CSV file's lines, or an in-memory table's rows.
@@ -78,26 +99,10 @@ struct Scaling {
 };
 
 Scaling scaling_of(const ImportOptions& options) {
-  const std::string& unit = options.length_unit;
-  if (!is_length_unit(unit)) {
-    throw Error("--length-unit '" + unit + "': expected one of m, cm, mm, um, voxel");
-  }
-  Scaling s{Eigen::Vector3d::Ones(), unit};
+  Scaling s{Eigen::Vector3d::Ones(), options.length_unit};
   if (options.voxel_size) {
-    if (unit != "voxel") {
-      throw Error("--voxel-size applies to voxel coordinates, but --length-unit is " + unit);
-    }
-    if (!is_physical_length_unit(options.voxel_size_unit)) {
-      throw Error("--voxel-size needs a length unit (m, cm, mm or um), e.g. 0.05,0.05,0.075mm");
-    }
-    if (!(options.voxel_size->array() > 0).all() || !options.voxel_size->allFinite()) {
-      throw Error("--voxel-size: expected three positive sizes");
-    }
     s.scale = *options.voxel_size;
     s.unit = options.voxel_size_unit;
-  }
-  if (options.radius && !(*options.radius > 0 && std::isfinite(*options.radius))) {
-    throw Error("--radius: expected a positive radius");
   }
   return s;
 }
@@ -123,48 +128,67 @@ void read_orientation(const Table& t, std::size_t r, const std::string& where, F
   frame.orientation.row(row) = q.normalized().transpose();
 }
 
-Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, const Source& csv,
-                         const ImportOptions& options, ImportSummary* summary) {
-  const Scaling scaling = scaling_of(options);
-  const Eigen::Vector3d& scale = scaling.scale;
-  const std::string& stored_unit = scaling.unit;
-  const std::size_t rows = t.rows();
-  if (rows == 0) {
+// The optional columns the table has, checked: an axis or an orientation whole, a radius
+// from the table or from the options, not both.
+struct Layout {
+  bool axis = false, orientation = false, hole_contact = false, radius = false;
+};
+
+Layout layout_of(const Table& t, const Source& csv, const ImportOptions& options) {
+  if (t.rows() == 0) {
     throw Error(csv.name +
                 (std::string(csv.row_word) == "line" ? ": no rows after the header" : ": no rows"));
   }
-  const bool has_axis = t.has("ax") || t.has("ay") || t.has("az");
-  if (has_axis && !(t.has("ax") && t.has("ay") && t.has("az"))) {
+  Layout l;
+  l.axis = t.has("ax") || t.has("ay") || t.has("az");
+  if (l.axis && !(t.has("ax") && t.has("ay") && t.has("az"))) {
     throw Error(csv.name + ": an axis needs all three columns ax, ay, az");
   }
-  const bool has_orientation = t.has("qw") || t.has("qx") || t.has("qy") || t.has("qz");
-  if (has_orientation && !(t.has("qw") && t.has("qx") && t.has("qy") && t.has("qz"))) {
+  l.orientation = t.has("qw") || t.has("qx") || t.has("qy") || t.has("qz");
+  if (l.orientation && !(t.has("qw") && t.has("qx") && t.has("qy") && t.has("qz"))) {
     throw Error(csv.name + ": an orientation needs all four columns qw, qx, qy, qz");
   }
-  if (t.has("radius") && options.radius) {
+  l.radius = t.has("radius");
+  if (l.radius && options.radius) {
     throw Error(csv.name + ": has a radius column; --radius is for tables without one");
   }
+  l.hole_contact = t.has("hole_contact");
+  return l;
+}
 
-  std::vector<std::int64_t> frame_of(rows), particle_of(rows);
-  for (std::size_t r = 0; r < rows; ++r) {
-    frame_of[r] = label(t["frame"].values[r], csv, lines[r], "frame");
-    particle_of[r] = label(t["particle"].values[r], csv, lines[r], "particle");
+// Each row's frame and particle labels, and the labels sorted: the run's frames and grains.
+struct Labels {
+  std::vector<std::int64_t> frame_of, particle_of;  // per row
+  std::vector<std::int64_t> frames, particles;      // sorted, each once
+};
+
+Labels labels_of(const Table& t, const std::vector<std::size_t>& lines, const Source& csv) {
+  Labels l;
+  l.frame_of.resize(t.rows());
+  l.particle_of.resize(t.rows());
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    l.frame_of[r] = label(t["frame"].values[r], csv, lines[r], "frame");
+    l.particle_of[r] = label(t["particle"].values[r], csv, lines[r], "particle");
   }
-  const std::vector<std::int64_t> frames = sorted_unique(frame_of);
-  const std::vector<std::int64_t> particles = sorted_unique(particle_of);
-  const std::size_t n = particles.size();
-  check_dense_size(csv, rows, frames.size(), n);
+  l.frames = sorted_unique(l.frame_of);
+  l.particles = sorted_unique(l.particle_of);
+  return l;
+}
 
+// The run before its rows are read: its header and a frame per label, every grain unknown.
+Trajectories empty_run(const Labels& labels, const Layout& layout, const Scaling& scaling,
+                       const Source& csv, const ImportOptions& options) {
+  const Eigen::Vector3d& scale = scaling.scale;
   Trajectories run;
   RunHeader& h = run.header;
-  h.length_unit = stored_unit;
+  h.length_unit = scaling.unit;
   h.time_unit = "cycle";  // a table of scans knows their order, not their times
   h.sample = options.sample;
-  h.id = particles;
-  h.has_axis = has_axis;
-  h.has_hole_contact = t.has("hole_contact");
-  h.has_orientation = has_orientation;
-  if (has_orientation && options.voxel_size && (scale.array() != scale.x()).any()) {
+  h.id = labels.particles;
+  h.has_axis = layout.axis;
+  h.has_hole_contact = layout.hole_contact;
+  h.has_orientation = layout.orientation;
+  if (layout.orientation && options.voxel_size && (scale.array() != scale.x()).any()) {
     throw Error(csv.name +
                 ": orientations with voxels of unequal sides would need turning; "
                 "give the table in lengths");
@@ -176,98 +200,158 @@ Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, 
     b.edges = b.edges.cwiseProduct(scale);
     h.box = b;
   }
-  for (std::int64_t f : frames) {
+  for (std::int64_t f : labels.frames) {
     Frame frame = Frame::unknown(h);
     frame.step = f;
     frame.time = static_cast<double>(f);
     run.frames.push_back(std::move(frame));
   }
+  return run;
+}
 
-  std::vector<double> radius_sum(n, 0);
-  std::vector<std::size_t> radius_count(n, 0);
-  std::vector<std::size_t> seen_at(frames.size() * n, 0);  // line of the row, 0 = none
-  std::size_t axes_known = 0;
-  for (std::size_t r = 0; r < rows; ++r) {
-    const std::size_t line = lines[r];
-    const std::size_t ti = index_of(frames, frame_of[r]);
-    const std::size_t gi = index_of(particles, particle_of[r]);
-    std::size_t& first = seen_at[ti * n + gi];
+// The rows read into the run's frames one by one: each (frame, grain) once, positions and
+// axes scaled to the stored unit, the radii each grain's rows give summed for their mean.
+class RowReader {
+ public:
+  RowReader(const Table& t, const Source& csv, const Labels& labels, const Layout& layout,
+            const Eigen::Vector3d& scale, Trajectories& run)
+      : t_(t),
+        csv_(csv),
+        labels_(labels),
+        layout_(layout),
+        scale_(scale),
+        run_(run),
+        n_(labels.particles.size()),
+        radius_sum_(n_, 0),
+        radius_count_(n_, 0),
+        seen_at_(labels.frames.size() * n_, 0) {}
+
+  // Row r, line `line` of the source.
+  void read(std::size_t r, std::size_t line) {
+    const std::size_t ti = index_of(labels_.frames, labels_.frame_of[r]);
+    const std::size_t gi = index_of(labels_.particles, labels_.particle_of[r]);
+    claim(r, line, seen_at_[ti * n_ + gi]);
+    Frame& frame = run_.frames[ti];
+    const auto row = static_cast<Eigen::Index>(gi);
+    frame.position.row(row) = position(r, line);
+    if (layout_.axis) read_axis(r, line, frame, row);
+    if (layout_.orientation) read_orientation(t_, r, at(csv_, line), frame, row);
+    if (layout_.hole_contact) frame.hole_contact[gi] = hole_contact(r, line);
+    if (layout_.radius) add_radius(r, line, gi);
+  }
+
+  // A grain's radius is a property of the grain: the mean of what the scans measured, else
+  // `radius` (the table's unit); NaN where neither is known.
+  std::vector<double> radii(const std::optional<double>& radius) const {
+    std::vector<double> r(n_, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t g = 0; g < n_; ++g) {
+      if (radius_count_[g])
+        r[g] = radius_sum_[g] / double(radius_count_[g]) * scale_.x();
+      else if (radius)
+        r[g] = *radius * scale_.x();
+    }
+    return r;
+  }
+
+  std::size_t axes_known() const { return axes_known_; }
+
+ private:
+  // The (frame, grain) of row r is taken by its line; `first` is the line of an earlier
+  // row there (0: none).
+  void claim(std::size_t r, std::size_t line, std::size_t& first) const {
     if (first) {
-      throw Error(at(csv, line) + ": particle " + std::to_string(particle_of[r]) +
-                  " appears twice in frame " + std::to_string(frame_of[r]) + " (first at line " +
-                  std::to_string(first) + ")");
+      throw Error(at(csv_, line) + ": particle " + std::to_string(labels_.particle_of[r]) +
+                  " appears twice in frame " + std::to_string(labels_.frame_of[r]) +
+                  " (first at line " + std::to_string(first) + ")");
     }
     first = line;
-    Frame& frame = run.frames[ti];
-    const auto row = static_cast<Eigen::Index>(gi);
-    const Eigen::Vector3d x(t["x"].values[r], t["y"].values[r], t["z"].values[r]);
+  }
+
+  Eigen::Vector3d position(std::size_t r, std::size_t line) const {
+    const Eigen::Vector3d x(t_["x"].values[r], t_["y"].values[r], t_["z"].values[r]);
     for (int k = 0; k < 3; ++k) {
       if (!std::isfinite(x[k])) {
-        throw Error(at(csv, line) + ", column '" + "xyz"[k] +
+        throw Error(at(csv_, line) + ", column '" + "xyz"[k] +
                     "': expected a finite coordinate, found " +
                     (std::isnan(x[k]) ? "nothing or nan" : "infinity"));
       }
     }
-    const Eigen::Vector3d scaled = x.cwiseProduct(scale);
+    const Eigen::Vector3d scaled = x.cwiseProduct(scale_);
     if (!scaled.allFinite()) {
-      throw Error(at(csv, line) +
+      throw Error(at(csv_, line) +
                   ": position (x,y,z) times the voxel size is beyond a double's range");
     }
-    frame.position.row(row) = scaled;
-    if (has_axis) {
-      const Eigen::Vector3d a(t["ax"].values[r], t["ay"].values[r], t["az"].values[r]);
-      const int unknown = a.array().isNaN().count();
-      if (unknown == 3) {
-        // The axis was not seen in this scan: keep NaN.
-      } else if (unknown > 0 || !a.allFinite()) {
-        throw Error(at(csv, line) + ": axis (ax,ay,az) must be three finite numbers or all empty");
-      } else {
-        // A direction in voxel space becomes a physical direction by the same scaling.
-        const Eigen::Vector3d p = a.cwiseProduct(scale);
-        // Any length: the stable norm neither overflows (1e200) nor underflows (1e-200).
-        if (p.stableNorm() == 0) throw Error(at(csv, line) + ": axis (ax,ay,az) has zero length");
-        frame.axis.row(row) = p.stableNormalized();
-        ++axes_known;
-      }
-    }
-    if (has_orientation) read_orientation(t, r, at(csv, line), frame, row);
-    if (h.has_hole_contact) {
-      const double flag = t["hole_contact"].values[r];
-      if (flag != 0 && flag != 1) {
-        throw Error(at(csv, line) + ", column 'hole_contact': expected 0 or 1");
-      }
-      frame.hole_contact[gi] = static_cast<std::uint8_t>(flag);
-    }
-    if (t.has("radius")) {
-      const double rad = t["radius"].values[r];
-      if (!std::isnan(rad)) {
-        if (!(rad > 0) || !std::isfinite(rad)) {
-          throw Error(at(csv, line) + ", column 'radius': expected a positive radius");
-        }
-        radius_sum[gi] += rad;
-        ++radius_count[gi];
-      }
-    }
+    return scaled;
   }
 
-  // A grain's radius is a property of the grain: average what the scans measured.
-  h.radius.assign(n, std::numeric_limits<double>::quiet_NaN());
-  for (std::size_t g = 0; g < n; ++g) {
-    if (radius_count[g])
-      h.radius[g] = radius_sum[g] / double(radius_count[g]) * scale.x();
-    else if (options.radius)
-      h.radius[g] = *options.radius * scale.x();
+  void read_axis(std::size_t r, std::size_t line, Frame& frame, Eigen::Index row) {
+    const Eigen::Vector3d a(t_["ax"].values[r], t_["ay"].values[r], t_["az"].values[r]);
+    const int unknown = a.array().isNaN().count();
+    if (unknown == 3) return;  // the axis was not seen in this scan: NaN kept
+    if (unknown > 0 || !a.allFinite()) {
+      throw Error(at(csv_, line) + ": axis (ax,ay,az) must be three finite numbers or all empty");
+    }
+    // A direction in voxel space becomes a physical direction by the same scaling.
+    const Eigen::Vector3d p = a.cwiseProduct(scale_);
+    // Any length: the stable norm neither overflows (1e200) nor underflows (1e-200).
+    if (p.stableNorm() == 0) throw Error(at(csv_, line) + ": axis (ax,ay,az) has zero length");
+    frame.axis.row(row) = p.stableNormalized();
+    ++axes_known_;
   }
+
+  std::uint8_t hole_contact(std::size_t r, std::size_t line) const {
+    const double flag = t_["hole_contact"].values[r];
+    if (flag != 0 && flag != 1) {
+      throw Error(at(csv_, line) + ", column 'hole_contact': expected 0 or 1");
+    }
+    return static_cast<std::uint8_t>(flag);
+  }
+
+  void add_radius(std::size_t r, std::size_t line, std::size_t grain) {
+    const double rad = t_["radius"].values[r];
+    if (std::isnan(rad)) return;
+    if (!(rad > 0) || !std::isfinite(rad)) {
+      throw Error(at(csv_, line) + ", column 'radius': expected a positive radius");
+    }
+    radius_sum_[grain] += rad;
+    ++radius_count_[grain];
+  }
+
+  const Table& t_;
+  const Source& csv_;
+  const Labels& labels_;
+  const Layout& layout_;
+  const Eigen::Vector3d scale_;
+  Trajectories& run_;
+  const std::size_t n_;
+  std::vector<double> radius_sum_;
+  std::vector<std::size_t> radius_count_;
+  std::vector<std::size_t> seen_at_;  // line of the row of each (frame, grain), 0 = none
+  std::size_t axes_known_ = 0;
+};
+
+Trajectories import_rows(const Table& t, const std::vector<std::size_t>& lines, const Source& csv,
+                         const ImportOptions& options, ImportSummary* summary) {
+  const Scaling scaling = scaling_of(options);
+  const Layout layout = layout_of(t, csv, options);
+  const Labels labels = labels_of(t, lines, csv);
+  const std::size_t rows = t.rows(), frames = labels.frames.size(), n = labels.particles.size();
+  check_dense_size(csv, rows, frames, n);
+  Trajectories run = empty_run(labels, layout, scaling, csv, options);
+  RowReader reader(t, csv, labels, layout, scaling.scale, run);
+  for (std::size_t r = 0; r < rows; ++r)
+    reader.read(r, lines[r]);
+  run.header.radius = reader.radii(options.radius);
 
   if (summary) {
     summary->source = csv.name;
-    summary->has_axis = has_axis;
+    summary->has_axis = layout.axis;
     summary->rows = rows;
-    summary->frames = frames.size();
+    summary->frames = frames;
     summary->grains = n;
-    summary->missing = frames.size() * n - rows;
-    summary->axes_known = axes_known;
-    summary->length_unit = stored_unit;
+    summary->missing = frames * n - rows;
+    summary->axes_known = reader.axes_known();
+    summary->length_unit = scaling.unit;
   }
   return run;
 }
@@ -331,6 +415,7 @@ Trajectories import_dump(const std::filesystem::path& path, const ImportOptions&
   const LammpsDump dump = read_lammps_dump(path, options.types);
   std::vector<std::string> notes;
   const ImportOptions o = dump_options(dump, path.string(), options, notes);
+  o.validate();  // the dump's unit may not be voxels, as a voxel size needs
   Trajectories run = import_rows(dump.table, dump.lines, Source{path.string(), "line"}, o, summary);
   if (summary) {
     summary->format = "lammps dump";
@@ -343,8 +428,8 @@ Trajectories import_dump(const std::filesystem::path& path, const ImportOptions&
 
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary) {
+  options.validate();  // before the file is read
   if (is_lammps_dump(csv)) return import_dump(csv, options, summary);
-  scaling_of(options);  // bad options refused before the file is read
   const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns, options.csv);
   Trajectories run =
       import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
@@ -354,6 +439,7 @@ Trajectories import_table(const std::filesystem::path& csv, const ImportOptions&
 
 Trajectories import_table(const Table& table, const std::string& source,
                           const ImportOptions& options, ImportSummary* summary) {
+  options.validate();
   for (const std::string& c : kRequiredColumns) {
     if (!table.has(c)) throw Error(source + ": no column '" + c + "'");
   }

@@ -76,10 +76,29 @@ Summary summarize(const std::vector<double>& values) {
   return s;
 }
 
+namespace {
+
+Error empty_range(bool log) {
+  return Error("pdf: empty value range (no finite values" + std::string(log ? " above zero" : "") +
+               ", or a range with low >= high)");
+}
+const char* const kLogRange = "pdf: logarithmic bins need a range above zero";
+
+}  // namespace
+
+void DensityOptions::validate() const {
+  if (bins == 0) throw Error("pdf: the number of bins must be at least 1");
+  if (!range) return;
+  const auto [lo, hi] = *range;
+  const bool log = scale == BinScale::logarithmic;
+  if (!(lo < hi) || !std::isfinite(lo) || !std::isfinite(hi)) throw empty_range(log);
+  if (log && lo <= 0) throw Error(kLogRange);
+}
+
 Table probability_density(const std::vector<double>& values, const DensityOptions& options,
                           const std::string& unit) {
+  options.validate();
   const bool log = options.scale == BinScale::logarithmic;
-  if (options.bins == 0) throw Error("pdf: the number of bins must be at least 1");
   std::size_t finite = 0;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   for (double x : values) {
@@ -97,11 +116,10 @@ Table probability_density(const std::vector<double>& values, const DensityOption
       hi = lo + pad;
       lo = log ? lo / (1 + 1e-6) : lo - pad;
     } else {
-      throw Error("pdf: empty value range (no finite values" +
-                  std::string(log ? " above zero" : "") + ", or a range with low >= high)");
+      throw empty_range(log);
     }
   }
-  if (log && lo <= 0) throw Error("pdf: logarithmic bins need a range above zero");
+  if (log && lo <= 0) throw Error(kLogRange);
 
   const std::size_t nb = options.bins;
   std::vector<double> edges(nb + 1);

@@ -363,6 +363,178 @@ const RunHeader& TrajectoryWriter::header() const {
   return impl_->header;
 }
 
+namespace {
+
+// The file's particles group: granmem's /particles/grains, or another H5MD producer's
+// single particle group. Error for a file that is not H5MD.
+std::string particles_group_of(const h5::File& file) {
+  const hid_t f = file.id();
+  if (!h5::exists(f, "/h5md")) {
+    throw Error(file.name() + ": not a granmem/H5MD trajectory file (no /h5md group)");
+  }
+  std::string group = kGrains;
+  if (!h5::exists(f, group) && h5::exists(f, "/particles")) {
+    h5::Handle particles = h5::open_group(file, "/particles");
+    const std::vector<std::string> groups = h5::member_names(particles.get());
+    if (groups.size() == 1) group = "/particles/" + groups.front();
+  }
+  return group;
+}
+
+// The positions' dataset <pos>/value, checked to be [frames, grains, 3].
+h5::Handle open_positions(const h5::File& file, const std::string& pos) {
+  h5::Handle position = h5::open_dataset(file, pos + "/value");
+  const std::vector<hsize_t> dims = h5::shape(position.get());
+  if (dims.size() != 3 || dims[2] != 3) {
+    throw Error(file.name() + ": dataset " + pos + "/value has shape " + h5::shape_text(dims) +
+                ", expected [frames,grains,3]");
+  }
+  return position;
+}
+
+struct FrameLabels {
+  std::vector<std::int64_t> steps;
+  std::vector<double> times;
+  std::string time_unit;
+};
+
+// Each frame's step and time. H5MD makes `time` optional: frames are then known by their
+// step alone (time = step, unit "step").
+FrameLabels read_frame_labels(const h5::File& file, const std::string& pos, hsize_t frames) {
+  FrameLabels l;
+  l.steps = frame_labels<std::int64_t>(file, pos + "/step", frames);
+  if (h5::exists(file.id(), pos + "/time")) {
+    l.times = frame_labels<double>(file, pos + "/time", frames);
+    l.time_unit = unit_of(h5::open_dataset(file, pos + "/time").get(), "s");
+  } else {
+    l.times.assign(l.steps.begin(), l.steps.end());
+    l.time_unit = "step";
+  }
+  if (l.steps.size() != frames || l.times.size() != frames) {
+    throw Error(file.name() + ": " + pos + "/step and /time must have one entry per frame (" +
+                std::to_string(frames) + ")");
+  }
+  return l;
+}
+
+// The positions' unit as the file states it into h.length_unit, checked, and what a frame
+// is (`sample`). H5MD makes `unit` optional: a file without one is taken in metres. Returns
+// the stated unit ("": none).
+std::string read_position_header(const h5::File& file, const std::string& pos,
+                                 const h5::Handle& position, RunHeader& h) {
+  const std::string stated = unit_of(position.get(), "");
+  h.length_unit = stated.empty() ? "m" : stated;
+  if (!is_length_unit(h.length_unit)) {
+    throw Error(file.name() + ": dataset " + pos + "/value has unit '" + h.length_unit +
+                "', expected one of m, cm, mm, um, voxel");
+  }
+  h5::Handle group = h5::open_group(file, pos);
+  h.sample = h5::read_string_attribute(group.get(), "sample").value_or(kSampleEndOfCycle);
+  return stated;
+}
+
+// The per-grain datasets: ids (default 0 ... n-1) and radii (default NaN), one per grain.
+void read_grains(const h5::File& file, const std::string& group, hsize_t n, RunHeader& h) {
+  const std::string id_path = group + "/id";
+  if (h5::exists(file.id(), id_path)) {
+    h.id = h5::read<std::int64_t>(file, id_path);
+    if (h.id.size() != n) {
+      throw Error(file.name() + ": dataset " + id_path + " must hold one id per grain (" +
+                  std::to_string(n) + ")");
+    }
+  } else {
+    for (hsize_t i = 0; i < n; ++i)
+      h.id.push_back(static_cast<std::int64_t>(i));
+  }
+  const std::string radius_path = group + "/radius";
+  h.radius.assign(n, std::numeric_limits<double>::quiet_NaN());
+  if (h5::exists(file.id(), radius_path)) {
+    h.radius = h5::read<double>(file, radius_path);
+    if (h.radius.size() != n) {
+      throw Error(file.name() + ": dataset " + radius_path + " must hold one radius per grain (" +
+                  std::to_string(n) + ")");
+    }
+  }
+}
+
+// A dataset of three values (Error naming it otherwise).
+Eigen::Vector3d read_vector3(const h5::File& file, const std::string& path) {
+  const std::vector<double> v = h5::read<double>(file, path);
+  if (v.size() != 3) throw Error(file.name() + ": dataset " + path + " must hold 3 values");
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+// The container: <group>/box/edges and, where given, its lower corner (box/offset).
+std::optional<Box> read_box(const h5::File& file, const std::string& group) {
+  const std::string edges_path = group + "/box/edges";
+  if (!h5::exists(file.id(), edges_path)) return std::nullopt;
+  Box box;
+  box.edges = read_vector3(file, edges_path);
+  const std::string offset_path = group + "/box/offset";
+  if (h5::exists(file.id(), offset_path)) box.lower = read_vector3(file, offset_path);
+  return box;
+}
+
+// An optional per-frame element <group>/<element>/value into `out`, checked to match the
+// positions frame for frame: [frames, frame_dims...]. False where the file has none.
+bool open_element(const h5::File& file, const std::string& group, const std::string& element,
+                  hsize_t frames, std::vector<hsize_t> frame_dims, h5::Handle& out) {
+  const std::string path = group + "/" + element + "/value";
+  if (!h5::exists(file.id(), path)) return false;
+  out = h5::open_dataset(file, path);
+  frame_dims.insert(frame_dims.begin(), frames);
+  if (h5::shape(out.get()) != frame_dims) {
+    throw Error(file.name() + ": dataset " + path + " has shape " +
+                h5::shape_text(h5::shape(out.get())) + ", expected " + h5::shape_text(frame_dims));
+  }
+  return true;
+}
+
+// Who made the file (/h5md's creator and author) and with what (/parameters, the voxel
+// size of image data among them).
+void read_provenance(const h5::File& file, RunHeader& h) {
+  const hid_t f = file.id();
+  if (h5::exists(f, "/h5md/creator")) {
+    h5::Handle creator = h5::open_group(file, "/h5md/creator");
+    h.creator_name = h5::read_string_attribute(creator.get(), "name").value_or("");
+    h.creator_version = h5::read_string_attribute(creator.get(), "version").value_or("");
+  }
+  if (h5::exists(f, "/h5md/author")) {
+    h5::Handle author = h5::open_group(file, "/h5md/author");
+    h.author = h5::read_string_attribute(author.get(), "name").value_or("");
+  }
+  if (h5::exists(f, "/parameters")) {
+    read_parameters(file, "/parameters", "", h.parameters);
+    if (h5::exists(f, "/parameters/voxel_size")) {
+      h.voxel_size = read_vector3(file, "/parameters/voxel_size");
+    }
+  }
+}
+
+// /observables/<name>/{value, step, time}, each of equal length.
+std::map<std::string, Observable> read_observables(const h5::File& file) {
+  std::map<std::string, Observable> observables;
+  if (!h5::exists(file.id(), "/observables")) return observables;
+  h5::Handle obs = h5::open_group(file, "/observables");
+  for (const std::string& o : h5::member_names(obs.get())) {
+    const std::string base = "/observables/" + o;
+    Observable ob;
+    ob.value = h5::read<double>(file, base + "/value");
+    ob.step = h5::read<std::int64_t>(file, base + "/step");
+    ob.time = h5::read<double>(file, base + "/time");
+    h5::Handle value = h5::open_dataset(file, base + "/value");
+    ob.unit = unit_of(value.get(), "1");
+    if (ob.step.size() != ob.value.size() || ob.time.size() != ob.value.size()) {
+      throw Error(file.name() + ": observable " + base +
+                  " needs value, step and time of equal length");
+    }
+    observables[o] = std::move(ob);
+  }
+  return observables;
+}
+
+}  // namespace
+
 struct TrajectoryReader::Impl {
   h5::File file;
   std::string group;
@@ -377,143 +549,27 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
     : impl_(std::make_unique<Impl>()) {
   Impl& r = *impl_;
   r.file = h5::File::open(path);
-  const std::string& name = r.file.name();
-  const hid_t f = r.file.id();
-  if (!h5::exists(f, "/h5md")) {
-    throw Error(name + ": not a granmem/H5MD trajectory file (no /h5md group)");
-  }
-  // granmem writes /particles/grains; another H5MD producer's single particle group works too.
-  r.group = kGrains;
-  if (!h5::exists(f, r.group) && h5::exists(f, "/particles")) {
-    h5::Handle particles = h5::open_group(r.file, "/particles");
-    const std::vector<std::string> groups = h5::member_names(particles.get());
-    if (groups.size() == 1) r.group = "/particles/" + groups.front();
-  }
+  r.group = particles_group_of(r.file);
   const std::string pos = r.group + "/position";
-  r.position = h5::open_dataset(r.file, pos + "/value");
+  r.position = open_positions(r.file, pos);
   const std::vector<hsize_t> dims = h5::shape(r.position.get());
-  if (dims.size() != 3 || dims[2] != 3) {
-    throw Error(name + ": dataset " + pos + "/value has shape " + h5::shape_text(dims) +
-                ", expected [frames,grains,3]");
-  }
   const hsize_t t_count = dims[0], n = dims[1];
   RunHeader& h = r.header;
-  // H5MD makes `time` optional: frames are then known by their step alone.
-  r.steps = frame_labels<std::int64_t>(r.file, pos + "/step", t_count);
-  if (h5::exists(f, pos + "/time")) {
-    r.times = frame_labels<double>(r.file, pos + "/time", t_count);
-    h.time_unit = unit_of(h5::open_dataset(r.file, pos + "/time").get(), "s");
-  } else {
-    r.times.assign(r.steps.begin(), r.steps.end());
-    h.time_unit = "step";
-  }
-  if (r.steps.size() != t_count || r.times.size() != t_count) {
-    throw Error(name + ": " + pos + "/step and /time must have one entry per frame (" +
-                std::to_string(t_count) + ")");
-  }
-
-  // H5MD makes `unit` optional: a file without one is taken in metres, and says so.
-  const std::string stated_unit = unit_of(r.position.get(), "");
-  h.length_unit = stated_unit.empty() ? "m" : stated_unit;
-  if (!is_length_unit(h.length_unit)) {
-    throw Error(name + ": dataset " + pos + "/value has unit '" + h.length_unit +
-                "', expected one of m, cm, mm, um, voxel");
-  }
-  {
-    h5::Handle group = h5::open_group(r.file, pos);
-    h.sample = h5::read_string_attribute(group.get(), "sample").value_or(kSampleEndOfCycle);
-  }
-
-  const std::string id_path = r.group + "/id";
-  if (h5::exists(f, id_path)) {
-    h.id = h5::read<std::int64_t>(r.file, id_path);
-    if (h.id.size() != n) {
-      throw Error(name + ": dataset " + id_path + " must hold one id per grain (" +
-                  std::to_string(n) + ")");
-    }
-  } else {
-    for (hsize_t i = 0; i < n; ++i)
-      h.id.push_back(static_cast<std::int64_t>(i));
-  }
-  const std::string radius_path = r.group + "/radius";
-  h.radius.assign(n, std::numeric_limits<double>::quiet_NaN());
-  if (h5::exists(f, radius_path)) {
-    h.radius = h5::read<double>(r.file, radius_path);
-    if (h.radius.size() != n) {
-      throw Error(name + ": dataset " + radius_path + " must hold one radius per grain (" +
-                  std::to_string(n) + ")");
-    }
-  }
-  const std::string edges_path = r.group + "/box/edges";
-  if (h5::exists(f, edges_path)) {
-    const std::vector<double> edges = h5::read<double>(r.file, edges_path);
-    if (edges.size() != 3) throw Error(name + ": dataset " + edges_path + " must hold 3 values");
-    Box box;
-    box.edges = Eigen::Vector3d(edges[0], edges[1], edges[2]);
-    const std::string offset_path = r.group + "/box/offset";
-    if (h5::exists(f, offset_path)) {
-      const std::vector<double> lower = h5::read<double>(r.file, offset_path);
-      if (lower.size() != 3) throw Error(name + ": dataset " + offset_path + " must hold 3 values");
-      box.lower = Eigen::Vector3d(lower[0], lower[1], lower[2]);
-    }
-    h.box = box;
-  }
-
-  // Optional per-frame elements must match the positions frame for frame.
-  auto open_element = [&](const std::string& element, std::vector<hsize_t> frame_dims,
-                          h5::Handle& out) {
-    const std::string path = r.group + "/" + element + "/value";
-    if (!h5::exists(f, path)) return false;
-    out = h5::open_dataset(r.file, path);
-    frame_dims.insert(frame_dims.begin(), t_count);
-    if (h5::shape(out.get()) != frame_dims) {
-      throw Error(name + ": dataset " + path + " has shape " +
-                  h5::shape_text(h5::shape(out.get())) + ", expected " +
-                  h5::shape_text(frame_dims));
-    }
-    return true;
-  };
-  h.has_axis = open_element("axis", {n, 3}, r.axis);
-  h.has_orientation = open_element("orientation", {n, 4}, r.orientation);
-  h.has_hole_contact = open_element("hole_contact", {n}, r.hole_contact);
-
-  if (h5::exists(f, "/h5md/creator")) {
-    h5::Handle creator = h5::open_group(r.file, "/h5md/creator");
-    h.creator_name = h5::read_string_attribute(creator.get(), "name").value_or("");
-    h.creator_version = h5::read_string_attribute(creator.get(), "version").value_or("");
-  }
-  if (h5::exists(f, "/h5md/author")) {
-    h5::Handle author = h5::open_group(r.file, "/h5md/author");
-    h.author = h5::read_string_attribute(author.get(), "name").value_or("");
-  }
-  if (h5::exists(f, "/parameters")) {
-    read_parameters(r.file, "/parameters", "", h.parameters);
-    if (h5::exists(f, "/parameters/voxel_size")) {
-      const std::vector<double> v = h5::read<double>(r.file, "/parameters/voxel_size");
-      if (v.size() != 3) throw Error(name + ": dataset /parameters/voxel_size must hold 3 values");
-      h.voxel_size = Eigen::Vector3d(v[0], v[1], v[2]);
-    }
-  }
+  FrameLabels labels = read_frame_labels(r.file, pos, t_count);
+  r.steps = std::move(labels.steps);
+  r.times = std::move(labels.times);
+  h.time_unit = labels.time_unit;
+  const std::string stated_unit = read_position_header(r.file, pos, r.position, h);
+  read_grains(r.file, r.group, n, h);
+  h.box = read_box(r.file, r.group);
+  h.has_axis = open_element(r.file, r.group, "axis", t_count, {n, 3}, r.axis);
+  h.has_orientation = open_element(r.file, r.group, "orientation", t_count, {n, 4}, r.orientation);
+  h.has_hole_contact = open_element(r.file, r.group, "hole_contact", t_count, {n}, r.hole_contact);
+  read_provenance(r.file, h);
   if (stated_unit.empty())
     h.parameters["h5md/length_unit"] = "m, assumed: the file's positions have no unit";
-  check_header(h, name);
-
-  if (h5::exists(f, "/observables")) {
-    h5::Handle obs = h5::open_group(r.file, "/observables");
-    for (const std::string& o : h5::member_names(obs.get())) {
-      const std::string base = "/observables/" + o;
-      Observable ob;
-      ob.value = h5::read<double>(r.file, base + "/value");
-      ob.step = h5::read<std::int64_t>(r.file, base + "/step");
-      ob.time = h5::read<double>(r.file, base + "/time");
-      h5::Handle value = h5::open_dataset(r.file, base + "/value");
-      ob.unit = unit_of(value.get(), "1");
-      if (ob.step.size() != ob.value.size() || ob.time.size() != ob.value.size()) {
-        throw Error(name + ": observable " + base + " needs value, step and time of equal length");
-      }
-      r.observables[o] = std::move(ob);
-    }
-  }
+  check_header(h, r.file.name());
+  r.observables = read_observables(r.file);
 }
 
 TrajectoryReader::~TrajectoryReader() = default;

@@ -27,6 +27,12 @@ Eigen::Vector3d axis_of(const RunHeader& header, const Frame& frame, std::size_t
 
 }  // namespace
 
+void MotionOptions::validate() const {
+  if (!(wall_distance >= 0) || !std::isfinite(wall_distance)) {
+    throw Error("--wall-distance: expected a length >= 0");
+  }
+}
+
 FrameMotion grain_motion(const RunHeader& header, const Frame& before, const Frame& after,
                          const MotionOptions& options) {
   const std::optional<Box>& box = options.box ? options.box : header.box;

@@ -22,127 +22,227 @@ void append(std::vector<double>& to, const std::vector<double>& values) {
   to.insert(to.end(), values.begin(), values.end());
 }
 
-}  // namespace
+void check_window(std::int64_t first, std::int64_t last) {
+  if (first > last)
+    throw Error("--window: first frame " + std::to_string(first) + " is after last frame " +
+                std::to_string(last));
+}
 
-MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions& options) {
-  const RunHeader& h = run.header();
-  const std::string& L = h.length_unit;
-  const bool rot = h.has_axis || h.has_orientation;
-  const bool full = h.has_orientation;
-  if (run.frame_count() < 2) {
-    throw Error(run.file_name() + ": needs at least two frames for displacements, has " +
-                std::to_string(run.frame_count()));
+// A frame pair's motion as the tables hold it: angles in degrees; the single-axis rotation
+// NaN where the run has neither axes nor orientations, the full one empty without the latter.
+struct TabledMotion {
+  const FrameMotion& m;
+  std::vector<double> theta_deg, rot_len, full_deg;
+};
+
+TabledMotion tabled(const FrameMotion& m, bool rot) {
+  const std::size_t n = m.grain.size();
+  return {m, rot ? in_degrees(m.theta_axis) : std::vector<double>(n, std::nan("")),
+          rot ? m.rot_disp : std::vector<double>(n, std::nan("")), in_degrees(m.theta_full)};
+}
+
+// The displacements table's columns: a row per grain followed from frame f-1 to frame f.
+class DisplacementColumns {
+ public:
+  DisplacementColumns(Table& d, const std::string& L, bool full)
+      : frame_(d.add("frame", "", true)),
+        particle_(d.add("particle", "", true)),
+        dx_(d.add("dx", L)),
+        dy_(d.add("dy", L)),
+        dz_(d.add("dz", L)),
+        dr_(d.add("dr", L)),
+        theta_axis_(d.add("theta_axis_deg", "deg")),
+        rot_disp_(d.add("rot_disp", L)),
+        theta_full_(full ? &d.add("theta_full_deg", "deg") : nullptr),
+        theta_body_x_(full ? &d.add("theta_body_x_deg", "deg") : nullptr),
+        theta_body_y_(full ? &d.add("theta_body_y_deg", "deg") : nullptr) {}
+
+  void add(const RunHeader& h, std::int64_t step, const TabledMotion& t) {
+    const FrameMotion& m = t.m;
+    for (std::size_t k = 0; k < m.grain.size(); ++k) {
+      const auto row = static_cast<Eigen::Index>(k);
+      frame_.values.push_back(double(step));
+      particle_.values.push_back(double(h.id[m.grain[k]]));
+      dx_.values.push_back(m.displacement(row, 0));
+      dy_.values.push_back(m.displacement(row, 1));
+      dz_.values.push_back(m.displacement(row, 2));
+    }
+    append(dr_.values, m.dr);
+    append(theta_axis_.values, t.theta_deg);
+    append(rot_disp_.values, t.rot_len);
+    if (theta_full_) {
+      append(theta_full_->values, t.full_deg);
+      append(theta_body_x_->values, in_degrees(m.theta_body_x));
+      append(theta_body_y_->values, in_degrees(m.theta_body_y));
+    }
   }
 
-  MotionAnalysis a;
-  a.length_unit = L;
-  Table& d = a.displacements;
-  Column& frame = d.add("frame", "", true);
-  Column& particle = d.add("particle", "", true);
-  Column& dx = d.add("dx", L);
-  Column& dy = d.add("dy", L);
-  Column& dz = d.add("dz", L);
-  Column& dr = d.add("dr", L);
-  Column& theta_axis = d.add("theta_axis_deg", "deg");
-  Column& rot_disp = d.add("rot_disp", L);
-  Column* theta_full = full ? &d.add("theta_full_deg", "deg") : nullptr;
-  Column* theta_body_x = full ? &d.add("theta_body_x_deg", "deg") : nullptr;
-  Column* theta_body_y = full ? &d.add("theta_body_y_deg", "deg") : nullptr;
+ private:
+  Column &frame_, &particle_, &dx_, &dy_, &dz_, &dr_, &theta_axis_, &rot_disp_;
+  Column *theta_full_, *theta_body_x_, *theta_body_y_;
+};
 
-  Table& p = a.per_frame;
-  Column& p_frame = p.add("frame", "", true);
-  Column& p_n = p.add("n", "", true);
-  Column& p_mean_dr = p.add("mean_dr", L);
-  Column& p_median_dr = p.add("median_dr", L);
-  Column& p_mean_theta = p.add("mean_theta_axis_deg", "deg");
-  Column& p_mean_rot = p.add("mean_rot_disp", L);
-  Column& p_median_theta = p.add("median_theta_axis_deg", "deg");
-  Column& p_median_rot = p.add("median_rot_disp", L);
-  Column& p_n_rot = p.add("n_rot", "", true);
-  Column& p_msd = p.add("msd", L.empty() ? "" : L + "^2");
-  Column* p_mean_full = full ? &p.add("mean_theta_full_deg", "deg") : nullptr;
-  Column* p_median_full = full ? &p.add("median_theta_full_deg", "deg") : nullptr;
-  Column& p_drift_x = p.add("drift_x", L);
-  Column& p_drift_y = p.add("drift_y", L);
-  Column& p_drift_z = p.add("drift_z", L);
-  Column& p_prev = p.add("prev_frame", "", true);
-  // The structure of frame f (not a change from f-1): from positions, as in a scan.
-  Column& p_packing = p.add("packing_fraction", "");
-  Column& p_coordination = p.add("coordination", "");
+// The per-frame table's columns: a row per frame pair f-1 -> f, with the structure of f.
+class PerFrameColumns {
+ public:
+  PerFrameColumns(Table& p, const std::string& L, bool full)
+      : frame_(p.add("frame", "", true)),
+        n_(p.add("n", "", true)),
+        mean_dr_(p.add("mean_dr", L)),
+        median_dr_(p.add("median_dr", L)),
+        mean_theta_(p.add("mean_theta_axis_deg", "deg")),
+        mean_rot_(p.add("mean_rot_disp", L)),
+        median_theta_(p.add("median_theta_axis_deg", "deg")),
+        median_rot_(p.add("median_rot_disp", L)),
+        n_rot_(p.add("n_rot", "", true)),
+        msd_(p.add("msd", L.empty() ? "" : L + "^2")),
+        mean_full_(full ? &p.add("mean_theta_full_deg", "deg") : nullptr),
+        median_full_(full ? &p.add("median_theta_full_deg", "deg") : nullptr),
+        drift_x_(p.add("drift_x", L)),
+        drift_y_(p.add("drift_y", L)),
+        drift_z_(p.add("drift_z", L)),
+        prev_(p.add("prev_frame", "", true)),
+        // The structure of frame f (not a change from f-1): from positions, as in a scan.
+        packing_(p.add("packing_fraction", "")),
+        coordination_(p.add("coordination", "")) {}
 
+  void add(std::int64_t step, std::int64_t prev_step, const TabledMotion& t,
+           const PackingStructure& structure) {
+    const FrameMotion& m = t.m;
+    const Summary s_dr = summarize(m.dr), s_theta = summarize(t.theta_deg),
+                  s_rot = summarize(t.rot_len);
+    frame_.values.push_back(double(step));
+    n_.values.push_back(double(m.grain.size()));
+    mean_dr_.values.push_back(s_dr.mean);
+    median_dr_.values.push_back(s_dr.median);
+    mean_theta_.values.push_back(s_theta.mean);
+    mean_rot_.values.push_back(s_rot.mean);
+    median_theta_.values.push_back(s_theta.median);
+    median_rot_.values.push_back(s_rot.median);
+    n_rot_.values.push_back(double(s_theta.count));
+    msd_.values.push_back(s_dr.mean_square);
+    if (mean_full_) {
+      const Summary s_full = summarize(t.full_deg);
+      mean_full_->values.push_back(s_full.mean);
+      median_full_->values.push_back(s_full.median);
+    }
+    drift_x_.values.push_back(m.drift.x());
+    drift_y_.values.push_back(m.drift.y());
+    drift_z_.values.push_back(m.drift.z());
+    prev_.values.push_back(double(prev_step));
+    packing_.values.push_back(structure.packing_fraction);
+    coordination_.values.push_back(structure.coordination);
+  }
+
+ private:
+  Column &frame_, &n_, &mean_dr_, &median_dr_, &mean_theta_, &mean_rot_, &median_theta_,
+      &median_rot_, &n_rot_, &msd_;
+  Column *mean_full_, *median_full_;
+  Column &drift_x_, &drift_y_, &drift_z_, &prev_, &packing_, &coordination_;
+};
+
+// The displacements and per-frame tables, frame pair by frame pair.
+void tabulate_motion(const TrajectoryReader& run, const AnalysisOptions& options,
+                     MotionAnalysis& a) {
+  const RunHeader& h = run.header();
+  const bool rot = h.has_axis || h.has_orientation;
+  DisplacementColumns displacements(a.displacements, h.length_unit, h.has_orientation);
+  PerFrameColumns per_frame(a.per_frame, h.length_unit, h.has_orientation);
   Frame before = run.read_frame(0);
   for (std::size_t t = 1; t < run.frame_count(); ++t) {
     Frame after = run.read_frame(t);
     const FrameMotion m = grain_motion(h, before, after, options.motion);
-    const std::size_t n = m.grain.size();
-    const std::vector<double> theta_deg =
-        rot ? in_degrees(m.theta_axis) : std::vector<double>(n, std::nan(""));
-    const std::vector<double> rot_len = rot ? m.rot_disp : std::vector<double>(n, std::nan(""));
-    for (std::size_t k = 0; k < n; ++k) {
-      const auto row = static_cast<Eigen::Index>(k);
-      frame.values.push_back(double(after.step));
-      particle.values.push_back(double(h.id[m.grain[k]]));
-      dx.values.push_back(m.displacement(row, 0));
-      dy.values.push_back(m.displacement(row, 1));
-      dz.values.push_back(m.displacement(row, 2));
-    }
-    append(dr.values, m.dr);
-    append(theta_axis.values, theta_deg);
-    append(rot_disp.values, rot_len);
-    const std::vector<double> full_deg = in_degrees(m.theta_full);  // empty without orientations
-    if (full) {
-      append(theta_full->values, full_deg);
-      append(theta_body_x->values, in_degrees(m.theta_body_x));
-      append(theta_body_y->values, in_degrees(m.theta_body_y));
-    }
-
-    const Summary s_dr = summarize(m.dr), s_theta = summarize(theta_deg),
-                  s_rot = summarize(rot_len);
-    p_frame.values.push_back(double(after.step));
-    p_n.values.push_back(double(n));
-    p_mean_dr.values.push_back(s_dr.mean);
-    p_median_dr.values.push_back(s_dr.median);
-    p_mean_theta.values.push_back(s_theta.mean);
-    p_mean_rot.values.push_back(s_rot.mean);
-    p_median_theta.values.push_back(s_theta.median);
-    p_median_rot.values.push_back(s_rot.median);
-    p_n_rot.values.push_back(double(s_theta.count));
-    p_msd.values.push_back(s_dr.mean_square);
-    if (full) {
-      const Summary s_full = summarize(full_deg);
-      p_mean_full->values.push_back(s_full.mean);
-      p_median_full->values.push_back(s_full.median);
-    }
-    p_drift_x.values.push_back(m.drift.x());
-    p_drift_y.values.push_back(m.drift.y());
-    p_drift_z.values.push_back(m.drift.z());
-    p_prev.values.push_back(double(before.step));
-    const PackingStructure structure =
-        packing_structure(after.position, h.radius, options.structure);
-    p_packing.values.push_back(structure.packing_fraction);
-    p_coordination.values.push_back(structure.coordination);
+    const TabledMotion motion = tabled(m, rot);
+    displacements.add(h, after.step, motion);
+    per_frame.add(after.step, before.step, motion,
+                  packing_structure(after.position, h.radius, options.structure));
     before = std::move(after);
   }
+}
+
+// The quantities whose pdfs are made: those asked for, else dr and the rotations the run has.
+std::vector<std::string> pdf_quantities(const AnalysisOptions& options, const RunHeader& h) {
+  std::vector<std::string> quantities = options.pdf_quantities;
+  if (quantities.empty()) {
+    quantities.push_back("dr");
+    if (h.has_axis || h.has_orientation)
+      quantities.insert(quantities.end(), {"theta_axis_deg", "rot_disp"});
+    if (h.has_orientation)
+      quantities.insert(quantities.end(),
+                        {"theta_full_deg", "theta_body_x_deg", "theta_body_y_deg"});
+  }
+  return quantities;
+}
+
+// The rows of the displacements table in frames first to last (labels).
+std::vector<std::size_t> rows_in_window(const Table& d, std::int64_t first, std::int64_t last) {
+  const std::vector<double>& frame = d["frame"].values;
+  std::vector<std::size_t> window;
+  for (std::size_t r = 0; r < d.rows(); ++r) {
+    if (frame[r] >= double(first) && frame[r] <= double(last)) window.push_back(r);
+  }
+  return window;
+}
+
+// Error unless `q` is a column of the displacements table other than frame and particle.
+void check_quantity(const Table& d, const std::string& q) {
+  if (q != "frame" && q != "particle" && d.has(q)) return;
+  std::string names;
+  for (const Column& c : d.columns()) {
+    if (c.name != "frame" && c.name != "particle") names += (names.empty() ? "" : ", ") + c.name;
+  }
+  throw Error("pdf of '" + q + "': not a quantity of this run (it has " + names + ")");
+}
+
+// The pdf of each quantity over the window's rows: one asked for must be made; a default
+// one without a measured value is skipped with a note.
+void add_pdfs(MotionAnalysis& a, const std::vector<std::size_t>& window,
+              const std::vector<std::string>& quantities, const AnalysisOptions& options) {
+  const Table& d = a.displacements;
+  const auto [first, last] = a.pdf_frames;
+  for (const std::string& q : quantities) {
+    check_quantity(d, q);
+    const Column& c = d[q];
+    std::vector<double> values;
+    values.reserve(window.size());
+    for (std::size_t r : window)
+      values.push_back(c.values[r]);
+    if (std::none_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
+      const std::string why = "no measured values of " + q + " in frames " + std::to_string(first) +
+                              " to " + std::to_string(last);
+      if (!options.pdf_quantities.empty()) throw Error("pdf of '" + q + "': " + why);
+      a.notes.push_back("no pdf of " + q + ": " + why);
+      continue;
+    }
+    a.pdfs[q] = probability_density(values, options.density, c.unit);
+  }
+}
+
+}  // namespace
+
+void AnalysisOptions::validate() const {
+  motion.validate();
+  if (pdf_frames) check_window(pdf_frames->first, pdf_frames->second);
+  density.validate();
+}
+
+MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions& options) {
+  options.validate();
+  if (run.frame_count() < 2) {
+    throw Error(run.file_name() + ": needs at least two frames for displacements, has " +
+                std::to_string(run.frame_count()));
+  }
+  MotionAnalysis a;
+  a.length_unit = run.header().length_unit;
+  tabulate_motion(run, options, a);
 
   // Pdfs pooled over a window of frames.
   const std::vector<std::int64_t>& steps = run.steps();
   a.pdf_frames = options.pdf_frames.value_or(std::make_pair(steps[1], steps.back()));
   const auto [first, last] = a.pdf_frames;
-  if (first > last)
-    throw Error("--window: first frame " + std::to_string(first) + " is after last frame " +
-                std::to_string(last));
-  std::vector<std::string> quantities = options.pdf_quantities;
-  if (quantities.empty()) {
-    quantities.push_back("dr");
-    if (rot) quantities.insert(quantities.end(), {"theta_axis_deg", "rot_disp"});
-    if (full)
-      quantities.insert(quantities.end(),
-                        {"theta_full_deg", "theta_body_x_deg", "theta_body_y_deg"});
-  }
-  std::vector<std::size_t> window;
-  for (std::size_t r = 0; r < d.rows(); ++r) {
-    if (frame.values[r] >= double(first) && frame.values[r] <= double(last)) window.push_back(r);
-  }
+  check_window(first, last);  // the default one too: a run's steps need not ascend
+  const std::vector<std::string> quantities = pdf_quantities(options, run.header());
+  const std::vector<std::size_t> window = rows_in_window(a.displacements, first, last);
   if (window.empty() && !options.pdf_frames) {
     a.notes.push_back("no pdfs: no grain was followed from one frame to the next");
     return a;
@@ -153,30 +253,7 @@ MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions
                 std::to_string(steps.front()) + " to " + std::to_string(steps.back()) +
                 ", displacements start at frame " + std::to_string(steps[1]) + ")");
   }
-  for (const std::string& q : quantities) {
-    if (q == "frame" || q == "particle" || !d.has(q)) {
-      std::string names;
-      for (const Column& c : d.columns()) {
-        if (c.name != "frame" && c.name != "particle")
-          names += (names.empty() ? "" : ", ") + c.name;
-      }
-      throw Error("pdf of '" + q + "': not a quantity of this run (it has " + names + ")");
-    }
-    const Column& c = d[q];
-    std::vector<double> values;
-    values.reserve(window.size());
-    for (std::size_t r : window)
-      values.push_back(c.values[r]);
-    if (std::none_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); })) {
-      const std::string why = "no measured values of " + q + " in frames " + std::to_string(first) +
-                              " to " + std::to_string(last);
-      // A pdf asked for must be made; a default one is skipped with a note.
-      if (!options.pdf_quantities.empty()) throw Error("pdf of '" + q + "': " + why);
-      a.notes.push_back("no pdf of " + q + ": " + why);
-      continue;
-    }
-    a.pdfs[q] = probability_density(values, options.density, c.unit);
-  }
+  add_pdfs(a, window, quantities, options);
   return a;
 }
 

@@ -32,7 +32,6 @@ struct TrainedState {
 
 // The trained states, read once and checked: between cycles, one box and one set of grains.
 std::vector<TrainedState> read_states(const std::vector<std::filesystem::path>& paths) {
-  if (paths.empty()) throw Error("readout: no trained state (--from)");
   std::vector<TrainedState> states;
   for (const std::filesystem::path& path : paths) {
     ProtocolState protocol;
@@ -57,19 +56,6 @@ std::vector<TrainedState> read_states(const std::vector<std::filesystem::path>& 
     }
   }
   return states;
-}
-
-void check_amplitudes(const std::vector<double>& amplitudes) {
-  if (amplitudes.empty()) throw Error("readout: no read-out amplitudes");
-  for (double a : amplitudes) {
-    if (!(std::isfinite(a) && a >= 0 && a < 0.5)) {
-      throw Error("readout: amplitude " + exact_text(a * 100) +
-                  " % of the box: must be at least 0 and less than half the box");
-    }
-  }
-  if (*std::max_element(amplitudes.begin(), amplitudes.end()) == 0) {
-    throw Error("readout: every amplitude is 0; a sweep needs a moving wall to time its cycles");
-  }
 }
 
 // The read-out cycle at `amplitude` (fraction of the box) for this state: the quasi-static
@@ -120,6 +106,23 @@ std::vector<double> amplitudes_for(const TrainedState& state, const ReadoutSweep
 
 }  // namespace
 
+void ReadoutSweepOptions::validate() const {
+  if (amplitudes.empty()) throw Error("readout: no read-out amplitudes");
+  for (double a : amplitudes) {
+    if (!(std::isfinite(a) && a >= 0 && a < 0.5)) {
+      throw Error("readout: amplitude " + exact_text(a * 100) +
+                  " % of the box: must be at least 0 and less than half the box");
+    }
+  }
+  if (*std::max_element(amplitudes.begin(), amplitudes.end()) == 0) {
+    throw Error("readout: every amplitude is 0; a sweep needs a moving wall to time its cycles");
+  }
+  if (cycles < 1) throw Error("readout: at least one read-out cycle per amplitude");
+  if (!(inertial_number > 0)) throw Error("readout: the inertial number must be positive");
+  if (states.empty()) throw Error("readout: no trained state (--from)");
+  if (dir.empty()) throw Error("readout: no output folder (--out)");
+}
+
 std::vector<double> parse_amplitude_sweep(const std::string& text) {
   const std::string what = "--amplitudes '" + text + "'";
   auto percentage = [&](const std::string& item) {
@@ -165,9 +168,7 @@ ReadoutSweepSummary run_readout_sweep(
     const ReadoutSweepOptions& o,
     const std::function<void(const ReadoutSweepProgress&)>& progress) {
   const auto start = std::chrono::steady_clock::now();
-  check_amplitudes(o.amplitudes);
-  if (o.cycles < 1) throw Error("readout: at least one read-out cycle per amplitude");
-  if (!(o.inertial_number > 0)) throw Error("readout: the inertial number must be positive");
+  o.validate();
   const std::vector<TrainedState> states = read_states(o.states);
 
   // Every run's settings, checked before any runs.

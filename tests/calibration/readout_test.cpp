@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "checks.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "temp_dir.hpp"
 
@@ -84,6 +85,23 @@ TEST_F(Readout, PointsAreTheKnownMeansFromTheTrainedState) {
   EXPECT_EQ(t["training_amplitude_pct"].values[0], 1);
   EXPECT_NEAR(t["dr_d"].values[1], 0.6, 1e-12);
   EXPECT_TRUE(std::isnan(t["reversibility_d"].values[0]));
+}
+
+// validate(): the sweep's part and the motion's, each bad value its one line.
+TEST(ReadoutOptions, ValidateDelegatesToTheSweepAndTheMotion) {
+  ReadoutOptions o;
+  o.sweep.states = {"trained.h5"};
+  o.sweep.amplitudes = {0.01};
+  o.sweep.dir = "readout";
+  EXPECT_NO_THROW(o.validate());
+  ReadoutOptions no_cycle = o;
+  no_cycle.sweep.cycles = 0;
+  EXPECT_EQ(testing::error_message([&] { no_cycle.validate(); }),
+            "readout: at least one read-out cycle per amplitude");
+  ReadoutOptions wall = o;
+  wall.motion.wall_distance = -1e-3;
+  EXPECT_EQ(testing::error_message([&] { readout(wall); }),
+            "--wall-distance: expected a length >= 0");
 }
 
 }  // namespace

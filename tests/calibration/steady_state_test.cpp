@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "checks.hpp"
+#include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/cycle_observables.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "temp_dir.hpp"
@@ -72,6 +74,27 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   EXPECT_NEAR(s.drift_of("wall_force_full_compression"), 10, 1e-12);
   EXPECT_NEAR(s.drift_of("rot_disp"), 0, 1e-12);
   EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
+}
+
+// compare's options (the window and wall distance it pools these observables with),
+// checked before either run is read: the defaults with a folder pass.
+TEST(CompareOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {
+  CompareOptions o;
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }), "compare: no output folder (--out)");
+  o.dir = "compare";
+  EXPECT_NO_THROW(o.validate());
+  CompareOptions window = o;
+  window.window = std::make_pair(std::int64_t(9), std::int64_t(3));
+  EXPECT_EQ(testing::error_message([&] { window.validate(); }),
+            "window 9:3: the first cycle is after the last");
+  CompareOptions diameter = o;
+  diameter.diameter = 0.0;
+  EXPECT_EQ(testing::error_message([&] { diameter.validate(); }),
+            "--diameter: expected a positive length");
+  CompareOptions wall = o;
+  wall.wall_distance = std::nan("");
+  EXPECT_EQ(testing::error_message([&] { wall.validate(); }),
+            "--wall-distance: expected a length >= 0");
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "checks.hpp"
 #include "granmem/core/error.hpp"
 #include "temp_dir.hpp"
 
@@ -328,6 +329,31 @@ TEST_F(ImportTable, BadOptionsAreErrors) {
   const auto file = path("good.csv");
   write_text(file, csv);
   EXPECT_EQ(import_table(file, good).header.length_unit, "mm");
+}
+
+// validate() alone, before any table: the defaults pass, a bad option is one line naming it.
+TEST(ImportOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {
+  using granmem::testing::error_message;
+  EXPECT_NO_THROW(ImportOptions{}.validate());
+  ImportOptions unit;
+  unit.length_unit = "inch";
+  EXPECT_EQ(error_message([&] { unit.validate(); }),
+            "--length-unit 'inch': expected one of m, cm, mm, um, voxel");
+  ImportOptions lengths;
+  lengths.length_unit = "mm";
+  lengths.voxel_size = Eigen::Vector3d(1, 1, 1);
+  lengths.voxel_size_unit = "mm";
+  EXPECT_EQ(error_message([&] { lengths.validate(); }),
+            "--voxel-size applies to voxel coordinates, but --length-unit is mm");
+  ImportOptions size;
+  size.voxel_size = Eigen::Vector3d(1, std::nan(""), 1);
+  size.voxel_size_unit = "mm";
+  EXPECT_EQ(error_message([&] { size.validate(); }), "--voxel-size: expected three positive sizes");
+  size.voxel_size = Eigen::Vector3d(0.05, 0.05, 0.075);
+  EXPECT_NO_THROW(size.validate());
+  ImportOptions radius;
+  radius.radius = 0.0;
+  EXPECT_EQ(error_message([&] { radius.validate(); }), "--radius: expected a positive radius");
 }
 
 // TrackMate's spot table: its own column names, quoted, three rows of names and units

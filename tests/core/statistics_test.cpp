@@ -227,6 +227,22 @@ TEST(ProbabilityDensity, InvalidRangeIsAnError) {
   EXPECT_EQ(probability_density({1, 2, 3}, o)["count"].values, (std::vector<double>{3, 0}));
 }
 
+TEST(DensityOptions, ValidateRefusesNoBinsAndAGivenRangeThatCannotHoldBins) {
+  using testing::error_message;
+  EXPECT_NO_THROW(DensityOptions{}.validate());
+  DensityOptions o;
+  o.bins = 0;
+  EXPECT_EQ(error_message([&] { o.validate(); }), "pdf: the number of bins must be at least 1");
+  o.bins = 10;
+  o.range = std::make_pair(3.0, 3.0);
+  EXPECT_EQ(error_message([&] { o.validate(); }),
+            "pdf: empty value range (no finite values, or a range with low >= high)");
+  o.range = std::make_pair(0.0, 3.0);
+  EXPECT_NO_THROW(o.validate());
+  o.scale = BinScale::logarithmic;
+  EXPECT_EQ(error_message([&] { o.validate(); }), "pdf: logarithmic bins need a range above zero");
+}
+
 TEST(Median, OfTheFiniteValuesWithTheMiddleTwoAveraged) {
   EXPECT_EQ(median({3, 1, 2}), 2);
   EXPECT_EQ(median({4, 1, 3, 2}), 2.5);

@@ -9,6 +9,7 @@
 #include <random>
 #include <vector>
 
+#include "checks.hpp"
 #include "granmem/core/error.hpp"
 
 namespace granmem {
@@ -415,6 +416,19 @@ TEST(GrainMotion, UnknownOrientationGivesNaNRotationsButKeepsTheTranslation) {
   EXPECT_TRUE(std::isnan(m.theta_full[1]));
   EXPECT_TRUE(std::isnan(m.rot_disp[1]));
   EXPECT_EQ(m.dr[1], 2.0);
+}
+
+TEST(MotionOptions, ValidateRefusesAWallDistanceThatIsNotALengthAtLeastZero) {
+  EXPECT_NO_THROW(MotionOptions{}.validate());
+  MotionOptions o;
+  o.wall_distance = 0.5;
+  EXPECT_NO_THROW(o.validate());
+  for (double bad : {-0.1, kNaN, std::numeric_limits<double>::infinity()}) {
+    o.wall_distance = bad;
+    EXPECT_EQ(testing::error_message([&] { o.validate(); }),
+              "--wall-distance: expected a length >= 0")
+        << bad;
+  }
 }
 
 }  // namespace

@@ -340,6 +340,24 @@ TEST_F(MotionAnalysisTest, PdfRequestsThatCannotBeMetAreErrors) {
   EXPECT_EQ(pdf_total_count(analyze_motion(run, options).pdfs.at("dz")), 5.0);
 }
 
+// validate() alone: the defaults pass; each part's bad value is refused with its line,
+// before any frame is read.
+TEST(AnalysisOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {
+  EXPECT_NO_THROW(AnalysisOptions{}.validate());
+  AnalysisOptions window;
+  window.pdf_frames = std::make_pair(7, 5);
+  EXPECT_EQ(error_message([&] { window.validate(); }),
+            "--window: first frame 7 is after last frame 5");
+  window.pdf_frames = std::make_pair(5, 5);
+  EXPECT_NO_THROW(window.validate());
+  AnalysisOptions wall;
+  wall.motion.wall_distance = -1;
+  EXPECT_EQ(error_message([&] { wall.validate(); }), "--wall-distance: expected a length >= 0");
+  AnalysisOptions bins;
+  bins.density.bins = 0;
+  EXPECT_EQ(error_message([&] { bins.validate(); }), "pdf: the number of bins must be at least 1");
+}
+
 TEST_F(MotionAnalysisTest, RunWithOneFrameHasNoDisplacements) {
   Trajectories run = three_grain_run();
   run.frames.resize(1);

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "checks.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
@@ -182,6 +183,33 @@ TEST_F(ReadoutSweep, BadInputIsRefusedWithOneLine) {
   o.states = {path("mid.h5")};
   refused(o, "middle of a cycle");
   EXPECT_FALSE(fs::exists(path("r")));  // nothing ran, nothing written
+}
+
+// validate() alone, before any state is read: a good sweep passes; each bad setting is its
+// one line, in the order the sweep checks them.
+TEST(ReadoutSweepOptions, ValidateNamesWhatIsWrongBeforeAnyStateIsRead) {
+  ReadoutSweepOptions o;
+  o.states = {"trained.h5"};  // not read by validate
+  o.amplitudes = {0.0, 0.01};
+  o.dir = "readout";
+  EXPECT_NO_THROW(o.validate());
+  auto message = [](const ReadoutSweepOptions& bad) {
+    return testing::error_message([&] { bad.validate(); });
+  };
+  ReadoutSweepOptions still = o;
+  still.amplitudes = {0.0};
+  EXPECT_EQ(message(still),
+            "readout: every amplitude is 0; a sweep needs a moving wall to time its cycles");
+  ReadoutSweepOptions half = o;
+  half.amplitudes = {0.5};
+  EXPECT_EQ(message(half),
+            "readout: amplitude 50 % of the box: must be at least 0 and less than half the box");
+  ReadoutSweepOptions inertial = o;
+  inertial.inertial_number = 0;
+  EXPECT_EQ(message(inertial), "readout: the inertial number must be positive");
+  ReadoutSweepOptions no_dir = o;
+  no_dir.dir.clear();
+  EXPECT_EQ(message(no_dir), "readout: no output folder (--out)");
 }
 
 TEST(AmplitudeSweep, ListsAndLogSpacedRangesOfPercentages) {

@@ -5,6 +5,8 @@
 
 #include "checks.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/tracking/track_run.hpp"
+#include "temp_dir.hpp"
 
 namespace granmem {
 namespace {
@@ -94,6 +96,34 @@ TEST(LinkRun, BadScansAndOptionsAreOneClearError) {
   LinkRunOptions unitless;
   unitless.container = "0,0,0,5,5,5";
   expect_error([&] { unitless.validate(); }, {"--container", "length unit"});
+}
+
+// track_run's options, checked before any scan is located or any folder made: its link and
+// locate parts, the scans there, an output named.
+class TrackRun : public testing::TempDirTest {};
+
+TEST_F(TrackRun, ValidateNamesTheBadOptionBeforeAnyScanIsLocated) {
+  TrackRunOptions o;
+  o.locate.diameter = "12";
+  o.out = path("run.h5");
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }), "track: no scans");
+  o.scans = {path("scan0.tif")};
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }),
+            "scan " + path("scan0.tif").string() + ": no such file or folder");
+  write_text(path("scan0.tif"), "");  // there (read only when located)
+  EXPECT_NO_THROW(o.validate());
+  o.link.memory = -1;
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }), "--memory: 0 or more scans");
+  o.link.memory = 2;
+  o.locate.diameter = "0";
+  o.detections = path("detections");
+  EXPECT_EQ(testing::error_message([&] { track_run(o); }),
+            "--diameter '0': expected a positive diameter");
+  EXPECT_FALSE(std::filesystem::exists(o.detections));
+  o.locate.diameter = "12";
+  o.out.clear();
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }),
+            "track: no --out (the trajectory store to write)");
 }
 
 }  // namespace

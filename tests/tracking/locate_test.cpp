@@ -1,4 +1,5 @@
 #include "granmem/tracking/locate.hpp"
+#include "granmem/tracking/locate_scan.hpp"
 
 #include <gtest/gtest.h>
 
@@ -382,6 +383,25 @@ TEST(Locate, DiameterLargerThanTheStackIsAnError) {
   EXPECT_NO_THROW(locate(stack, o));
   o.diameter = 0;
   EXPECT_NE(error_message([&] { locate(stack, o); }).find("positive"), std::string::npos);
+}
+
+// locate_scan's options checked before the stack is read: the diameter's text (a length is
+// turned into voxels with each stack's voxel size later) and locate's settings.
+TEST(ScanLocateOptions, ValidateNamesTheBadOptionBeforeTheStackIsRead) {
+  ScanLocateOptions o;
+  o.diameter = "12";
+  EXPECT_NO_THROW(o.validate());
+  o.diameter = "1.5mm";
+  EXPECT_NO_THROW(o.validate());
+  o.diameter = "-3";
+  EXPECT_EQ(error_message([&] { o.validate(); }), "--diameter '-3': expected a positive diameter");
+  o.diameter = "3furlong";
+  EXPECT_EQ(error_message([&] { o.validate(); }),
+            "--diameter '3furlong': unknown unit furlong (m, cm, mm, um, vox)");
+  o.diameter = "12";
+  o.locate.passes = 11;
+  EXPECT_EQ(error_message([&] { locate_scan("no_such_scan.tif", o); }),
+            "locate: passes must be 1 to 10");
 }
 
 }  // namespace

@@ -572,5 +572,26 @@ TEST_F(RenderRun, TheFrameByItsLabelDrawnAndWritten) {
   EXPECT_FALSE(std::filesystem::exists(o.out));
 }
 
+// validate() before the run is read: the defaults (with a run and --out) pass; a bad
+// drawing option or --voxel-size is one line naming it, and nothing is written.
+TEST_F(RenderRun, ValidateNamesTheBadOptionBeforeTheRunIsRead) {
+  RenderRunOptions o;
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }),
+            "render: no run to draw (a trajectory store)");
+  o.run = path("not_there.h5");
+  EXPECT_EQ(testing::error_message([&] { o.validate(); }),
+            "render: no --out (the TIFF stack to write)");
+  o.out = path("scan.tif");
+  EXPECT_NO_THROW(o.validate());
+  o.voxel_size = "0.5,-1,0.5mm";
+  EXPECT_EQ(testing::error_message([&] { render_run(o); }),
+            "--voxel-size '0.5,-1,0.5mm': sizes must be positive");
+  o.voxel_size.clear();
+  o.render.flicker = -0.5;
+  EXPECT_EQ(testing::error_message([&] { render_run(o); }),
+            "render: flicker must be >= 0, got -0.5");
+  EXPECT_FALSE(std::filesystem::exists(o.out));
+}
+
 }  // namespace
 }  // namespace granmem

@@ -75,17 +75,17 @@ Volume ball_mean(const Volume& vol, const Eigen::Array3d& semi) {
   return out;
 }
 
-}  // namespace
-
-std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const CandidateOptions& o,
-                                             const std::vector<HoledSphere>* found,
-                                             const Eigen::Vector3d& voxel_size,
-                                             const std::vector<Eigen::Vector3d>* tried) {
-  // Grain fraction binned by b voxels along each axis, b keeping six or more bins per
-  // diameter: less memory and work, and neighbours still apart.
+// Bins of b voxels along each axis, b keeping six or more bins per diameter: less memory
+// and work, and neighbours still apart.
+Eigen::Array3i bin_sizes(const Eigen::Vector3d& diameter) {
   Eigen::Array3i bin;
   for (int k = 0; k < 3; ++k)
-    bin[k] = std::clamp(int(std::lround(o.diameter[k] / 6)), 1, 4);
+    bin[k] = std::clamp(int(std::lround(diameter[k] / 6)), 1, 4);
+  return bin;
+}
+
+// The grain fraction (1 - fluid fraction, clamped to [0, 1]) averaged over each bin.
+Volume binned_grain_fraction(const Stack& stack, const Eigen::Array3i& bin) {
   Volume vol;
   vol.nx = (stack.nx + bin[0] - 1) / bin[0];
   vol.ny = (stack.ny + bin[1] - 1) / bin[1];
@@ -109,111 +109,122 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
       }
     }
   }
-  // Grains already found are taken out of the grain fraction (their model, binned alike),
-  // so that only what they do not explain is left.
-  if (found) {
-    const double per_bin = 1.0 / (bin[0] * bin[1] * bin[2]);
-    for (const HoledSphere& g : *found) {
-      const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
-      const Eigen::Vector3d reach =
-          Eigen::Vector3d::Constant(g.radius + 3 * g.blur).cwiseQuotient(voxel_size);
-      const Eigen::Vector3d lo = (c - reach).array().ceil().max(0.0);
-      const Eigen::Vector3d hi = (c + reach).array().floor().min(
-          Eigen::Array3d(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1)));
-      for (auto Z = std::int64_t(lo.z()); Z <= std::int64_t(hi.z()); ++Z) {
-        for (auto Y = std::int64_t(lo.y()); Y <= std::int64_t(hi.y()); ++Y) {
-          for (auto X = std::int64_t(lo.x()); X <= std::int64_t(hi.x()); ++X) {
-            const Eigen::Vector3d p =
-                Eigen::Vector3d(double(X), double(Y), double(Z)).cwiseProduct(voxel_size);
-            vol.at(X / bin[0], Y / bin[1], Z / bin[2]) -= float(per_bin * g.value(p));
-          }
+  return vol;
+}
+
+// Grains already found taken out of the binned grain fraction (their model, binned alike),
+// so that only what they do not explain is left.
+void subtract_found(Volume& vol, const Stack& stack, const Eigen::Array3i& bin,
+                    const std::vector<HoledSphere>& found, const Eigen::Vector3d& voxel_size) {
+  const double per_bin = 1.0 / (bin[0] * bin[1] * bin[2]);
+  for (const HoledSphere& g : found) {
+    const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
+    const Eigen::Vector3d reach =
+        Eigen::Vector3d::Constant(g.radius + 3 * g.blur).cwiseQuotient(voxel_size);
+    const Eigen::Vector3d lo = (c - reach).array().ceil().max(0.0);
+    const Eigen::Vector3d hi = (c + reach).array().floor().min(
+        Eigen::Array3d(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1)));
+    for (auto Z = std::int64_t(lo.z()); Z <= std::int64_t(hi.z()); ++Z) {
+      for (auto Y = std::int64_t(lo.y()); Y <= std::int64_t(hi.y()); ++Y) {
+        for (auto X = std::int64_t(lo.x()); X <= std::int64_t(hi.x()); ++X) {
+          const Eigen::Vector3d p =
+              Eigen::Vector3d(double(X), double(Y), double(Z)).cwiseProduct(voxel_size);
+          vol.at(X / bin[0], Y / bin[1], Z / bin[2]) -= float(per_bin * g.value(p));
         }
       }
     }
   }
-  // A ball of 0.8 radius: at a grain's centre it holds only that grain (and its hole, the
-  // same share wherever the ball sits on the axis); moved off, it loses grain in proportion
-  // and gains a neighbour's only as the square. A Gaussian's tails reach the neighbours in
-  // a packing and its weight on the centre feels the hole: its maxima wander.
-  vol = ball_mean(vol, 0.4 * o.diameter.array() / bin.cast<double>());
+}
 
-  struct Peak {
-    Eigen::Vector3d x;
-    float response;
-  };
+struct Peak {
+  Eigen::Vector3d x;  // voxel coordinates of the full grid
+  float response;
+};
+
+// Whether bin (x, y, z) is above each of its 26 neighbours; ties go to the first in memory
+// order, so that a plateau gives one peak.
+bool is_local_maximum(const Volume& vol, std::int64_t x, std::int64_t y, std::int64_t z) {
+  const float c = vol.at(x, y, z);
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (!dx && !dy && !dz) continue;
+        const std::int64_t X = x + dx, Y = y + dy, Z = z + dz;
+        if (X < 0 || Y < 0 || Z < 0 || X >= vol.nx || Y >= vol.ny || Z >= vol.nz) continue;
+        const float n = vol.at(X, Y, Z);
+        if (n > c || (n == c && (Z * vol.ny + Y) * vol.nx + X < (z * vol.ny + y) * vol.nx + x)) {
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+// The maximum at bin (x, y, z) to sub-bin precision: along each axis, the vertex of the
+// parabola through it and its two neighbours (within half a bin; none at the border).
+Eigen::Vector3d refined_maximum(const Volume& vol, std::int64_t x, std::int64_t y, std::int64_t z) {
+  const double c = vol.at(x, y, z);
+  Eigen::Vector3d at = Eigen::Vector3d(double(x), double(y), double(z));
+  const std::int64_t idx[3] = {x, y, z}, n[3] = {vol.nx, vol.ny, vol.nz};
+  for (int k = 0; k < 3; ++k) {
+    if (idx[k] == 0 || idx[k] == n[k] - 1) continue;
+    std::int64_t lo[3] = {x, y, z}, hi[3] = {x, y, z};
+    --lo[k];
+    ++hi[k];
+    const double m = vol.at(lo[0], lo[1], lo[2]), p = vol.at(hi[0], hi[1], hi[2]);
+    const double curvature = m - 2 * c + p;
+    if (curvature < 0) at[k] += std::clamp(0.5 * (m - p) / curvature, -0.5, 0.5);
+  }
+  return at;
+}
+
+// The local maxima of at least `min_response`, in the full grid's voxel coordinates (bin
+// k covers voxels b k ... b k + b - 1), slice by slice.
+std::vector<Peak> peaks_of(const Volume& vol, const Eigen::Array3i& bin, double min_response) {
+  const Eigen::Array3d b = bin.cast<double>();
   std::vector<std::vector<Peak>> by_slice(std::size_t(vol.nz));
 #pragma omp parallel for schedule(dynamic, 2)
   for (std::int64_t z = 0; z < vol.nz; ++z) {
     for (std::int64_t y = 0; y < vol.ny; ++y) {
       for (std::int64_t x = 0; x < vol.nx; ++x) {
         const float c = vol.at(x, y, z);
-        if (c < o.min_response) continue;
-        bool peak = true;
-        for (int dz = -1; dz <= 1 && peak; ++dz) {
-          for (int dy = -1; dy <= 1 && peak; ++dy) {
-            for (int dx = -1; dx <= 1 && peak; ++dx) {
-              if (!dx && !dy && !dz) continue;
-              const std::int64_t X = x + dx, Y = y + dy, Z = z + dz;
-              if (X < 0 || Y < 0 || Z < 0 || X >= vol.nx || Y >= vol.ny || Z >= vol.nz) continue;
-              const float n = vol.at(X, Y, Z);
-              // Ties go to the first in memory order, so a plateau gives one peak.
-              if (n > c ||
-                  (n == c && (Z * vol.ny + Y) * vol.nx + X < (z * vol.ny + y) * vol.nx + x)) {
-                peak = false;
-              }
-            }
-          }
-        }
-        if (!peak) continue;
-        // Sub-voxel: the vertex of a parabola through the maximum and its two neighbours.
-        Eigen::Vector3d at = Eigen::Vector3d(double(x), double(y), double(z));
-        const std::int64_t idx[3] = {x, y, z}, n[3] = {vol.nx, vol.ny, vol.nz};
-        for (int k = 0; k < 3; ++k) {
-          if (idx[k] == 0 || idx[k] == n[k] - 1) continue;
-          std::int64_t lo[3] = {x, y, z}, hi[3] = {x, y, z};
-          --lo[k];
-          ++hi[k];
-          const double m = vol.at(lo[0], lo[1], lo[2]), p = vol.at(hi[0], hi[1], hi[2]);
-          const double curvature = m - 2 * c + p;
-          if (curvature < 0) at[k] += std::clamp(0.5 * (m - p) / curvature, -0.5, 0.5);
-        }
-        // Back to the full grid: bin k covers voxels b k ... b k + b - 1.
-        const Eigen::Array3d b = bin.cast<double>();
-        by_slice[std::size_t(z)].push_back({(b * at.array() + 0.5 * (b - 1)).matrix(), c});
+        if (c < min_response || !is_local_maximum(vol, x, y, z)) continue;
+        const Eigen::Array3d at = refined_maximum(vol, x, y, z).array();
+        by_slice[std::size_t(z)].push_back({(b * at + 0.5 * (b - 1)).matrix(), c});
       }
     }
   }
   std::vector<Peak> peaks;
   for (auto& f : by_slice)
     peaks.insert(peaks.end(), f.begin(), f.end());
-  // Within `reach` diameters (along each axis) of one of `centres` (physical).
-  const auto drop_near = [&](const std::vector<Eigen::Vector3d>& centres, double reach) {
-    if (centres.empty()) return;
-    Vectors3 scaled(Eigen::Index(centres.size()), 3);
-    for (std::size_t k = 0; k < centres.size(); ++k) {
-      scaled.row(Eigen::Index(k)) =
-          centres[k].cwiseQuotient(voxel_size).cwiseQuotient(o.diameter).transpose();
-    }
-    const PointIndex index(std::move(scaled));
-    PointIndex::Hits hits;
-    const auto near = [&](const Peak& p) {
-      index.within(p.x.cwiseQuotient(o.diameter), reach, hits);
-      return !hits.empty();
-    };
-    peaks.erase(std::remove_if(peaks.begin(), peaks.end(), near), peaks.end());
-  };
-  if (found) {
-    std::vector<Eigen::Vector3d> centres;
-    for (const HoledSphere& g : *found)
-      centres.push_back(g.centre);
-    drop_near(centres, 0.5);
+  return peaks;
+}
+
+// Drops the peaks within `reach` diameters (along each axis) of one of `centres` (physical).
+void drop_near(std::vector<Peak>& peaks, const std::vector<Eigen::Vector3d>& centres, double reach,
+               const Eigen::Vector3d& voxel_size, const Eigen::Vector3d& diameter) {
+  if (centres.empty()) return;
+  Vectors3 scaled(Eigen::Index(centres.size()), 3);
+  for (std::size_t k = 0; k < centres.size(); ++k) {
+    scaled.row(Eigen::Index(k)) =
+        centres[k].cwiseQuotient(voxel_size).cwiseQuotient(diameter).transpose();
   }
-  if (tried) drop_near(*tried, 0.25);
+  const PointIndex index(std::move(scaled));
+  PointIndex::Hits hits;
+  const auto near = [&](const Peak& p) {
+    index.within(p.x.cwiseQuotient(diameter), reach, hits);
+    return !hits.empty();
+  };
+  peaks.erase(std::remove_if(peaks.begin(), peaks.end(), near), peaks.end());
+}
+
+// The peaks kept strongest first, each at least `separation` (per axis, an ellipsoid) from
+// every stronger one kept; a grid of cells one separation wide finds the close ones.
+std::vector<Eigen::Vector3d> strongest_apart(std::vector<Peak> peaks,
+                                             const Eigen::Vector3d& separation) {
   std::stable_sort(peaks.begin(), peaks.end(),
                    [](const Peak& a, const Peak& b) { return a.response > b.response; });
-
-  // Strongest first; a grid of cells one separation wide finds the close ones.
-  const Eigen::Vector3d separation = o.min_separation * o.diameter;
   CellGrid grid(separation);
   std::vector<Eigen::Vector3d> kept;
   for (const Peak& p : peaks) {
@@ -227,6 +238,31 @@ std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const Candidate
     kept.push_back(p.x);
   }
   return kept;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> find_candidates(const Stack& stack, const CandidateOptions& o,
+                                             const std::vector<HoledSphere>* found,
+                                             const Eigen::Vector3d& voxel_size,
+                                             const std::vector<Eigen::Vector3d>* tried) {
+  const Eigen::Array3i bin = bin_sizes(o.diameter);
+  Volume vol = binned_grain_fraction(stack, bin);
+  if (found) subtract_found(vol, stack, bin, *found, voxel_size);
+  // A ball of 0.8 radius: at a grain's centre it holds only that grain (and its hole, the
+  // same share wherever the ball sits on the axis); moved off, it loses grain in proportion
+  // and gains a neighbour's only as the square. A Gaussian's tails reach the neighbours in
+  // a packing and its weight on the centre feels the hole: its maxima wander.
+  vol = ball_mean(vol, 0.4 * o.diameter.array() / bin.cast<double>());
+  std::vector<Peak> peaks = peaks_of(vol, bin, o.min_response);
+  if (found) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const HoledSphere& g : *found)
+      centres.push_back(g.centre);
+    drop_near(peaks, centres, 0.5, voxel_size, o.diameter);
+  }
+  if (tried) drop_near(peaks, *tried, 0.25, voxel_size, o.diameter);
+  return strongest_apart(std::move(peaks), o.min_separation * o.diameter);
 }
 
 }  // namespace granmem

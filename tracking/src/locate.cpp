@@ -567,15 +567,29 @@ Detections locate(Stack stack, const LocateOptions& o, LocateSummary* summary) {
   return d;
 }
 
-double diameter_in_voxels(const std::string& text, const Stack& stack, const std::string& what) {
+namespace {
+
+bool in_voxels(const Quantity& diameter) {
+  const std::string& u = diameter.unit;
+  return u.empty() || u == "vox" || u == "voxel" || u == "px";
+}
+
+}  // namespace
+
+void check_diameter(const std::string& text, const std::string& what) {
   const Quantity q = parse_quantity(text, what);
   if (!std::isfinite(q.value) || !(q.value > 0)) {
     throw Error(what + " '" + text + "': expected a positive diameter");
   }
-  if (q.unit.empty() || q.unit == "vox" || q.unit == "voxel" || q.unit == "px") return q.value;
-  if (!is_physical_length_unit(q.unit)) {
+  if (!in_voxels(q) && !is_physical_length_unit(q.unit)) {
     throw Error(what + " '" + text + "': unknown unit " + q.unit + " (m, cm, mm, um, vox)");
   }
+}
+
+double diameter_in_voxels(const std::string& text, const Stack& stack, const std::string& what) {
+  check_diameter(text, what);
+  const Quantity q = parse_quantity(text, what);
+  if (in_voxels(q)) return q.value;
   if (!stack.voxel_size) {
     throw Error(what + " '" + text + "': " + stack.source +
                 " has no voxel size: give the diameter in voxels, or --voxel-size");

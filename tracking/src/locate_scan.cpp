@@ -6,7 +6,15 @@
 
 namespace granmem {
 
+void ScanLocateOptions::validate() const {
+  check_diameter(diameter, "--diameter");
+  LocateOptions settings = locate;
+  settings.diameter = 1;  // set from `diameter` as each stack is read
+  settings.validate();
+}
+
 LocatedScan locate_scan(const std::filesystem::path& path, const ScanLocateOptions& options) {
+  options.validate();
   Stack stack = read_stack(path, options.read);
   LocateOptions o = options.locate;
   o.diameter = diameter_in_voxels(options.diameter, stack, "--diameter");

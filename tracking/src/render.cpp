@@ -31,61 +31,6 @@ void require(bool ok, const std::string& what, double value) {
   if (!ok) throw Error("render: " + what + ", got " + text(value));
 }
 
-void check_options(const RenderOptions& o) {
-  if (o.voxel_size) {
-    for (int a = 0; a < 3; ++a) {
-      require(std::isfinite((*o.voxel_size)[a]) && (*o.voxel_size)[a] > 0,
-              "voxel size must be positive", (*o.voxel_size)[a]);
-    }
-  }
-  require(std::isfinite(o.diameter_px) && o.diameter_px > 0, "diameter_px must be positive",
-          o.diameter_px);
-  require(std::isfinite(o.slice_spacing_ratio) && o.slice_spacing_ratio > 0,
-          "slice_spacing_ratio must be positive", o.slice_spacing_ratio);
-  if (o.origin) {
-    for (int a = 0; a < 3; ++a)
-      require(std::isfinite((*o.origin)[a]), "origin", (*o.origin)[a]);
-  }
-  if (o.size) {
-    for (int a = 0; a < 3; ++a) {
-      require((*o.size)[a] > 0, "stack size must be at least 1 voxel", double((*o.size)[a]));
-    }
-  }
-  require(std::isfinite(o.margin) && o.margin >= 0, "margin must be >= 0 voxels", o.margin);
-  require(o.hole_fraction >= 0 && o.hole_fraction < 1, "hole_fraction must be in [0, 1)",
-          o.hole_fraction);
-  require(std::isfinite(o.fluid()) && o.fluid() >= 0, "fluid level must be >= 0", o.fluid());
-  require(std::isfinite(o.grain()) && o.grain() >= 0, "grain level must be >= 0", o.grain());
-  require(o.edge_tolerance > 0, "edge_tolerance must be positive", o.edge_tolerance);
-  for (int a = 0; a < 3; ++a) {
-    require(std::isfinite(o.blur_sigma[a]) && o.blur_sigma[a] >= 0, "blur sigma must be >= 0",
-            o.blur_sigma[a]);
-  }
-  require(std::isfinite(o.attenuation) && o.attenuation >= 0, "attenuation must be >= 0",
-          o.attenuation);
-  require(std::isfinite(o.flicker) && o.flicker >= 0, "flicker must be >= 0", o.flicker);
-  require(std::isfinite(o.streaks_per_slice) && o.streaks_per_slice >= 0,
-          "streaks_per_slice must be >= 0", o.streaks_per_slice);
-  require(std::isfinite(o.streak_strength) && o.streak_strength >= 0,
-          "streak_strength must be >= 0", o.streak_strength);
-  require(std::isfinite(o.streak_width) && o.streak_width > 0, "streak_width must be positive",
-          o.streak_width);
-  if (o.wall) {
-    require(o.wall->axis == 0 || o.wall->axis == 1, "wall axis must be 0 (x) or 1 (y)",
-            o.wall->axis);
-    require(std::isfinite(o.wall->position), "wall position must be finite", o.wall->position);
-    require(std::isfinite(o.wall->thickness) && o.wall->thickness > 0,
-            "wall thickness must be positive", o.wall->thickness);
-    require(std::isfinite(o.wall->level) && o.wall->level >= 0, "wall level must be >= 0",
-            o.wall->level);
-  }
-  require(std::isfinite(o.read_noise) && o.read_noise >= 0, "read_noise must be >= 0",
-          o.read_noise);
-  require(std::isfinite(o.gain) && o.gain >= 0, "gain must be >= 0", o.gain);
-  require(o.bits == 8 || o.bits == 16, "bits must be 8 or 16", o.bits);
-  require(o.slices_per_block >= 0, "slices_per_block must be >= 0", double(o.slices_per_block));
-}
-
 void check_grains(const std::vector<RenderedGrain>& grains) {
   for (const RenderedGrain& g : grains) {
     if (!g.centre.allFinite() || !std::isfinite(g.radius) || !(g.radius > 0)) {
@@ -213,6 +158,57 @@ SheetLight sheet_light(const RenderOptions& o, std::int64_t z, std::int64_t firs
 
 }  // namespace
 
+void RenderOptions::validate() const {
+  if (voxel_size) {
+    for (int a = 0; a < 3; ++a) {
+      require(std::isfinite((*voxel_size)[a]) && (*voxel_size)[a] > 0,
+              "voxel size must be positive", (*voxel_size)[a]);
+    }
+  }
+  require(std::isfinite(diameter_px) && diameter_px > 0, "diameter_px must be positive",
+          diameter_px);
+  require(std::isfinite(slice_spacing_ratio) && slice_spacing_ratio > 0,
+          "slice_spacing_ratio must be positive", slice_spacing_ratio);
+  if (origin) {
+    for (int a = 0; a < 3; ++a)
+      require(std::isfinite((*origin)[a]), "origin", (*origin)[a]);
+  }
+  if (size) {
+    for (int a = 0; a < 3; ++a) {
+      require((*size)[a] > 0, "stack size must be at least 1 voxel", double((*size)[a]));
+    }
+  }
+  require(std::isfinite(margin) && margin >= 0, "margin must be >= 0 voxels", margin);
+  require(hole_fraction >= 0 && hole_fraction < 1, "hole_fraction must be in [0, 1)",
+          hole_fraction);
+  require(std::isfinite(fluid()) && fluid() >= 0, "fluid level must be >= 0", fluid());
+  require(std::isfinite(grain()) && grain() >= 0, "grain level must be >= 0", grain());
+  require(edge_tolerance > 0, "edge_tolerance must be positive", edge_tolerance);
+  for (int a = 0; a < 3; ++a) {
+    require(std::isfinite(blur_sigma[a]) && blur_sigma[a] >= 0, "blur sigma must be >= 0",
+            blur_sigma[a]);
+  }
+  require(std::isfinite(attenuation) && attenuation >= 0, "attenuation must be >= 0", attenuation);
+  require(std::isfinite(flicker) && flicker >= 0, "flicker must be >= 0", flicker);
+  require(std::isfinite(streaks_per_slice) && streaks_per_slice >= 0,
+          "streaks_per_slice must be >= 0", streaks_per_slice);
+  require(std::isfinite(streak_strength) && streak_strength >= 0, "streak_strength must be >= 0",
+          streak_strength);
+  require(std::isfinite(streak_width) && streak_width > 0, "streak_width must be positive",
+          streak_width);
+  if (wall) {
+    require(wall->axis == 0 || wall->axis == 1, "wall axis must be 0 (x) or 1 (y)", wall->axis);
+    require(std::isfinite(wall->position), "wall position must be finite", wall->position);
+    require(std::isfinite(wall->thickness) && wall->thickness > 0,
+            "wall thickness must be positive", wall->thickness);
+    require(std::isfinite(wall->level) && wall->level >= 0, "wall level must be >= 0", wall->level);
+  }
+  require(std::isfinite(read_noise) && read_noise >= 0, "read_noise must be >= 0", read_noise);
+  require(std::isfinite(gain) && gain >= 0, "gain must be >= 0", gain);
+  require(bits == 8 || bits == 16, "bits must be 8 or 16", bits);
+  require(slices_per_block >= 0, "slices_per_block must be >= 0", double(slices_per_block));
+}
+
 RenderOptions RenderOptions::without_artefacts() const {
   RenderOptions o = *this;
   o.blur_sigma.setZero();
@@ -236,7 +232,7 @@ double RenderOptions::grain() const {
 }
 
 ScanGeometry scan_geometry(const std::vector<RenderedGrain>& grains, const RenderOptions& options) {
-  check_options(options);
+  options.validate();
   check_grains(grains);
   ScanGeometry g;
   if (options.voxel_size) {

@@ -64,7 +64,15 @@ std::string RenderSummary::Report() const {
   return s.str();
 }
 
+void RenderRunOptions::validate() const {
+  if (run.empty()) throw Error("render: no run to draw (a trajectory store)");
+  if (out.empty()) throw Error("render: no --out (the TIFF stack to write)");
+  if (!voxel_size.empty()) parse_voxel_size(voxel_size, "--voxel-size");
+  render.validate();
+}
+
 RenderSummary render_run(const RenderRunOptions& options) {
+  options.validate();
   const TrajectoryReader run(options.run);
   const RunHeader& h = run.header();
   const std::size_t index = frame_index(run, options.frame, options.run);

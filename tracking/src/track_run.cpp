@@ -16,13 +16,20 @@ std::string TrackSummary::Report() const {
   return s + "\n";
 }
 
-TrackSummary track_run(const TrackRunOptions& o) {
-  for (const std::filesystem::path& scan : o.scans) {
+void TrackRunOptions::validate() const {
+  link.validate();
+  if (scans.empty()) throw Error("track: no scans");
+  for (const std::filesystem::path& scan : scans) {
     if (!std::filesystem::exists(scan)) {
       throw Error("scan " + scan.string() + ": no such file or folder");
     }
   }
-  o.link.validate();
+  locate.validate();
+  if (out.empty()) throw Error("track: no --out (the trajectory store to write)");
+}
+
+TrackSummary track_run(const TrackRunOptions& o) {
+  o.validate();
   if (!o.detections.empty()) std::filesystem::create_directories(o.detections);
   TrackSummary summary;
   std::vector<Detections> found;

@@ -58,7 +58,13 @@ struct CompareOptions {
   bool subtract_drift = true;
   std::size_t steady_points = 0;  // relaxation: 0 fits the steady state (PowerLawOptions)
   std::filesystem::path dir;      // where the tables and figures go
+
+  // Throws Error naming the option: a window whose first cycle is after its last, a
+  // diameter that is not a positive length, a wall distance that is not a length >= 0, no
+  // output folder.
+  void validate() const;
 };
+// Validates the options, then compares the runs (compare_runs).
 Comparison compare(const TrajectoryReader& a, const TrajectoryReader& b, const CompareOptions& o);
 
 // The window `compare` pools by default: both runs' last 10 common cycles.

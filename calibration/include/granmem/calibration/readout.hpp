@@ -23,6 +23,10 @@ struct ReadoutOptions {
   MotionOptions motion;
   std::size_t bootstrap = 200;  // resamples of the grains for each error
   std::uint64_t seed = 1;       // of the bootstrap
+
+  // Throws Error naming what is wrong: the sweep's options (ReadoutSweepOptions::validate),
+  // the motion's (MotionOptions::validate).
+  void validate() const;
 };
 
 // One point of a read-out curve: a state read out at amplitude A', after read-out cycle
@@ -81,7 +85,7 @@ std::vector<ReadoutPoint> readout_points(const ReadoutRun& run, const ReadoutOpt
 // rot_single_d, rot_single_err_d, rot_full_d, rot_full_err_d, reversibility_d).
 Table readout_table(const std::vector<ReadoutPoint>& points);
 
-// Runs (or reuses) the sweep, computes every point and signature and writes
+// Validates the options, runs (or reuses) the sweep, computes every point and signature and writes
 // <dir>/readout.csv and <dir>/memory.csv. In an
 // MPI job every rank calls it and shares the runs; rank 0 alone computes the points and
 // writes the table (the other ranks return the sweep only).

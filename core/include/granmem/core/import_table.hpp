@@ -33,6 +33,10 @@ struct ImportOptions {
   // LAMMPS dumps: the atom types that are grains (not a lid or wall particles); empty
   // keeps every atom.
   std::set<long long> types;
+
+  // Throws Error naming the option: an unknown length unit, a voxel size without voxel
+  // coordinates, a length unit or three positive sizes, a radius that is not positive.
+  void validate() const;
 };
 
 struct ImportSummary {

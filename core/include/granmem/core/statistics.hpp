@@ -50,6 +50,10 @@ struct DensityOptions {
   // Histogram range; default the finite values' min and max (smallest positive value for
   // logarithmic bins).
   std::optional<std::pair<double, double>> range;
+
+  // Throws Error for no bins, or a range given that is empty, not finite, or (logarithmic
+  // bins) not above zero.
+  void validate() const;
 };
 
 // The probability density of `values` in bins of equal width (linear) or equal ratio

@@ -26,6 +26,9 @@ struct MotionOptions {
   // The container for `wall_distance`; default the run's box.
   std::optional<Box> box;
   HoleContactPolicy hole_contacts = HoleContactPolicy::keep;
+
+  // Throws Error for a wall distance that is not a length >= 0.
+  void validate() const;
 };
 
 // How the grains moved between two frames: one entry per grain seen in both and kept

@@ -25,6 +25,11 @@ struct AnalysisOptions {
   std::optional<std::pair<std::int64_t, std::int64_t>> pdf_frames;
   DensityOptions density;
   StructureOptions structure;  // the per-frame packing fraction and coordination
+
+  // Throws Error naming the option: the motion's and the pdfs' options
+  // (MotionOptions::validate, DensityOptions::validate), a window whose first frame is
+  // after its last.
+  void validate() const;
 };
 
 // The paper's statistics of a run between consecutive frames f-1 -> f.
@@ -44,6 +49,7 @@ struct MotionAnalysis {
   std::pair<std::int64_t, std::int64_t> pdf_frames{0, 0};
 };
 
+// Validates the options, then the run: at least two frames, the pdfs asked for measured.
 MotionAnalysis analyze_motion(const TrajectoryReader& run, const AnalysisOptions& options);
 
 // Writes DIR/displacements.csv, DIR/per_frame.csv, DIR/pdf_<quantity>.csv and

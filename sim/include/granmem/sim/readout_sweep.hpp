@@ -30,6 +30,11 @@ struct ReadoutSweepOptions {
   bool include_training_amplitude = true;
   std::filesystem::path dir;  // the runs' stores (readout_run_path), made if missing
   RunPoolOptions pool;
+
+  // Throws Error naming what is wrong before any state is read: no amplitudes, a negative
+  // one or one of half the box or more, every one 0, no read-out cycle, an inertial number
+  // that is not positive, no state, no output folder.
+  void validate() const;
 };
 
 struct ReadoutRun {
@@ -51,9 +56,9 @@ struct ReadoutSweepSummary {
   double wall_seconds = 0;
 };
 
-// Checks every state and amplitude before running anything (Error naming the bad one: a
-// file that is not a checkpoint, a state in the middle of a cycle, states of other boxes
-// or grains, no amplitudes, a negative one or one of half the box or more), then runs
+// Validates the options and checks every state before running anything (Error naming the
+// bad one: a file that is not a checkpoint, a state in the middle of a cycle, states of
+// other boxes or grains), then runs
 // the sweep on the pool. Runs whose store exists with the same state, amplitude and
 // cycles are reused, not run again. `progress` is called as runs finish.
 ReadoutSweepSummary run_readout_sweep(

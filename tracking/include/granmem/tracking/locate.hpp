@@ -63,5 +63,8 @@ Detections locate(Stack stack, const LocateOptions& options, LocateSummary* summ
 // The grain diameter in voxels along x from "12", "12 vox" (or px), or a length ("1.5mm")
 // with the stack's voxel size; Error naming `what` (the option) otherwise.
 double diameter_in_voxels(const std::string& text, const Stack& stack, const std::string& what);
+// What diameter_in_voxels checks before it needs the stack: a positive diameter in voxels
+// or with a length unit (Error naming `what`).
+void check_diameter(const std::string& text, const std::string& what);
 
 }  // namespace granmem

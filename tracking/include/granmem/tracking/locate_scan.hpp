@@ -17,6 +17,11 @@ struct ScanLocateOptions {
   std::string diameter;    // "12", "12vox" (voxels along x) or a length ("1.5mm")
   LocateOptions locate;    // its diameter is set from `diameter` and the stack
   std::int64_t frame = 0;  // the scan's index, in the detections' frame column
+
+  // Throws Error naming the option: a diameter that is not positive voxels or a length,
+  // a locate setting out of its range (LocateOptions::validate). A length is turned into
+  // voxels, and checked against the stack's voxel size, as each stack is read.
+  void validate() const;
 };
 
 struct LocatedScan {
@@ -27,6 +32,7 @@ struct LocatedScan {
   std::string Report() const;
 };
 
+// Validates the options, reads the scan and locates its grains.
 LocatedScan locate_scan(const std::filesystem::path& path, const ScanLocateOptions& options);
 
 }  // namespace granmem

@@ -116,6 +116,8 @@ struct RenderOptions {
   RenderOptions without_artefacts() const;
   double fluid() const;
   double grain() const;
+  // Throws Error naming the first option out of its range ("render: ..., got <value>").
+  void validate() const;
 };
 
 // Where the stack lies: resolved from the options and, where they leave it open, the grains.

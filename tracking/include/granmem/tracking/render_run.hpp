@@ -23,6 +23,10 @@ struct RenderRunOptions {
   std::string voxel_size;
   // The options as the user gave them, in the truth table's comment lines.
   std::map<std::string, std::string> parameters;
+
+  // Throws Error naming the option: no run or --out, a --voxel-size that is not positive
+  // sizes, a drawing option out of its range (RenderOptions::validate).
+  void validate() const;
 };
 
 struct RenderSummary {
@@ -37,8 +41,8 @@ struct RenderSummary {
   std::string Report() const;  // what the command line prints
 };
 
-// Finds the frame (Error naming the frames the run has), draws it and writes the scan and
-// the truth: the truth goes to a temporary first and into place only once the scan is
+// Validates the options, finds the frame (Error naming the frames the run has), draws it and writes
+// the scan and the truth: the truth goes to a temporary first and into place only once the scan is
 // written, so that both stay as they were if anything fails.
 RenderSummary render_run(const RenderRunOptions& options);
 

@@ -22,6 +22,10 @@ struct TrackRunOptions {
   std::filesystem::path out, report;  // the trajectory store; the unlinked table (optional)
   std::map<std::string, std::string> parameters;  // added to the run's
   std::function<void(const std::string&)> log;    // each scan's line as it is located
+
+  // Throws Error before any scan is located: the link's options (LinkRunOptions), no scan
+  // or one that is not there, the locate options (ScanLocateOptions), no --out.
+  void validate() const;
 };
 
 struct TrackSummary {
@@ -36,8 +40,8 @@ struct TrackSummary {
 std::filesystem::path detections_path(const std::filesystem::path& folder,
                                       const std::filesystem::path& scan);
 
-// Throws Error for a scan that is not there before any is located; then as locate_scan,
-// link_run and write_link_run.
+// Validates the options (nothing is made before), then throws as locate_scan, link_run and
+// write_link_run.
 TrackSummary track_run(const TrackRunOptions& options);
 
 }  // namespace granmem

@@ -113,6 +113,7 @@ constexpr SiUnit kSiUnits[] = {
 double parse_si(std::string_view text, Dimension dimension, std::string_view default_unit,
                 std::string_view what) {
   Quantity q = parse_quantity(text, what);
+  if (q.unit.empty() && q.value == 0) return 0;  // zero in every unit ("--lid-pressure 0")
   if (q.unit.empty()) q.unit = std::string(default_unit);
   std::string accepted;
   for (const SiUnit& u : kSiUnits) {

@@ -117,7 +117,7 @@ TEST_F(LammpsEngine, WhatLammpsCannotRunIsRefusedBeforeAnyWork) {
   };
   expect_clean_failure(with(small_run("p.h5", "1"), {"--polydispersity", "0.1"}),
                        {"--engine lammps", "one size", "--polydispersity 0"});
-  expect_clean_failure(with(small_run("p.h5", "1"), {"--lid-pressure", "0Pa"}),
+  expect_clean_failure(with(small_run("p.h5", "1"), {"--lid-pressure", "0"}),
                        {"--engine lammps", "lid"});
   expect_clean_failure(with(small_run("p.h5", "1"), {"--full-compression", "yes"}),
                        {"--engine lammps", "--full-compression", "--engine granmem"});

@@ -43,6 +43,12 @@ TEST(Units, PressuresInSi) {
   EXPECT_DOUBLE_EQ(parse_si("4360dyn/cm^2", Dimension::pressure, "", "p"), 436);
   EXPECT_THROW(parse_si("436", Dimension::pressure, "", "p"), Error);     // needs a unit
   EXPECT_THROW(parse_si("436 kg", Dimension::pressure, "", "p"), Error);  // not a pressure
+  // Zero needs no unit ("--lid-pressure 0: no lid", as its help says); zero with a wrong
+  // unit is still wrong.
+  EXPECT_EQ(parse_si("0", Dimension::pressure, "", "p"), 0.0);
+  EXPECT_EQ(parse_si("0.0", Dimension::length, "", "d"), 0.0);
+  EXPECT_THROW(parse_si("0 kg", Dimension::pressure, "", "p"), Error);
+  EXPECT_THROW(parse_si("1e-300", Dimension::pressure, "", "p"), Error);
 }
 
 }  // namespace

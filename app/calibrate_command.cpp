@@ -97,10 +97,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--threads", args->threads, "runs at once (default: all cores)");
   // The twin's settings: as `simulate` takes them, here or in the config's [simulate].
   std::map<std::string, CLI::Option*> given;
+  const RunSettings defaults = default_simulate_settings();
   for (std::size_t k = 0; k < kSimulateOptionCount; ++k) {
     const OptionSpec& o = kSimulateOptions[k];
     if (!is_twin_setting(o.name)) continue;
-    args->twin[o.name] = o.default_value;
+    args->twin[o.name] = defaults.at(o.name);
     given[o.name] = cmd->add_option(std::string("--") + o.name, args->twin[o.name],
                                     std::string("twin: ") + o.help)
                         ->capture_default_str()

@@ -48,9 +48,10 @@ SimulateSettings add_simulate(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "simulate", "Deposit grains in the box under a lid and compress them cyclically (DEM)");
   std::map<std::string, CLI::Option*> given;
+  const RunSettings defaults = default_simulate_settings();
   for (std::size_t k = 0; k < kSimulateOptionCount; ++k) {
     const OptionSpec& o = kSimulateOptions[k];
-    args->value[o.name] = o.default_value;
+    args->value[o.name] = defaults.at(o.name);
     given[o.name] = cmd->add_option(std::string("--") + o.name, args->value[o.name], o.help)
                         ->capture_default_str();
   }

@@ -1,6 +1,7 @@
 #include "granmem/sim/simulate_settings.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <iterator>
 #include <sstream>
 
@@ -15,38 +16,38 @@ constexpr const char* kPaperLidPressureText = "436Pa";  // kPaperLidPressure, as
 }  // namespace
 
 const OptionSpec kSimulateOptions[] = {
-    {"grains", "2000", "number of grains"},
+    {"grains", nullptr, "number of grains"},
     {"cycles", "10", "compression cycles"},
     {"amplitude", "1%", "wall amplitude A: a length (0.15cm) or a fraction of the box (1%)"},
     {"drive", "asymmetric", "asymmetric (0 -> A -> 0) or symmetric (0 -> A/2 -> -A/2 -> 0)"},
     {"wall-motion", "cosine", "cosine (smooth) or linear"},
     {"period", "auto", "cycle period (25ms...), or auto: the inertial number below"},
     {"inertial-number", "1e-3", "quasi-static limit for the automatic period"},
-    {"box", "15cm", "side of the square box"},
-    {"diameter", "0.5cm", "grain diameter"},
-    {"polydispersity", "0", "radii uniform in r(1 +- p)"},
-    {"density", "1.18g/cm^3", "grain density"},
+    {"box", nullptr, "side of the square box"},
+    {"diameter", nullptr, "grain diameter"},
+    {"polydispersity", nullptr, "radii uniform in r(1 +- p)"},
+    {"density", nullptr, "grain density"},
     {"lid-pressure", kPaperLidPressureText,
      "pressure of the free lid on the packing (436Pa: the paper's 1 kg on 15 x 15 cm; 0: no "
      "lid)"},
     {"lid-mass", "auto", "mass of the free lid (auto: from --lid-pressure; 0: no lid)"},
-    {"k-n", "4e6g/s^2", "normal spring constant"},
-    {"restitution-n", "0.2", "normal restitution coefficient"},
-    {"restitution-t", "0.5", "tangential restitution coefficient"},
-    {"kt-over-kn", "0.714285714285714", "tangential over normal spring constant (5/7)"},
-    {"mu-s", "0.2", "sliding friction between grains"},
-    {"mu-r", "0.01", "rolling friction"},
-    {"mu-t", "0.001", "twisting friction"},
-    {"beta", "0.5", "shape parameter of rolling and twisting"},
+    {"k-n", nullptr, "normal spring constant"},
+    {"restitution-n", nullptr, "normal restitution coefficient"},
+    {"restitution-t", nullptr, "tangential restitution coefficient"},
+    {"kt-over-kn", nullptr, "tangential over normal spring constant (5/7)"},
+    {"mu-s", nullptr, "sliding friction between grains"},
+    {"mu-r", nullptr, "rolling friction"},
+    {"mu-t", nullptr, "twisting friction"},
+    {"beta", nullptr, "shape parameter of rolling and twisting"},
     {"wall-mu-s", "same", "sliding friction on walls and lid (same: as between grains)"},
     {"wall-mu-r", "same", "rolling friction on walls and lid"},
     {"wall-mu-t", "same", "twisting friction on walls and lid"},
-    {"dt", "25us", "time step"},
-    {"skin", "0.05cm", "neighbour-list skin"},
-    {"gravity", "9.81m/s^2", "gravity"},
-    {"seed", "1", "seed of the deposition"},
-    {"settled-energy", "1e-13J", "kinetic energy per grain below which a packing is settled"},
-    {"settling-damping", "5", "drag rate while settling, 1/s"},
+    {"dt", nullptr, "time step"},
+    {"skin", nullptr, "neighbour-list skin"},
+    {"gravity", nullptr, "gravity"},
+    {"seed", nullptr, "seed of the deposition"},
+    {"settled-energy", nullptr, "kinetic energy per grain below which a packing is settled"},
+    {"settling-damping", nullptr, "drag rate while settling, 1/s"},
     {"full-compression", "false", "also write frames at full compression"},
     {"track", "", "grain ids sampled inside cycles, comma list"},
     {"samples-per-cycle", "0", "in-cycle samples of the tracked grains"},
@@ -90,10 +91,50 @@ const char* const kPackingOptions[] = {"grains",
                                        "settling-damping"};
 const std::size_t kPackingOptionCount = std::size(kPackingOptions);
 
+namespace {
+
+// A number as the settings write it: 15 significant digits, so that a default scaled into
+// the unit shown (25e-6 s as 25us) reads as typed.
+std::string number_text(double value, const char* unit = "") {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.15g%s", value, unit);
+  return text;
+}
+
+// The defaults the library's structs hold (PhysicsOptions, ContactParameters,
+// DepositOptions: the paper's table), in the units the help shows them in.
+RunSettings library_defaults() {
+  const PhysicsOptions p;
+  const ContactParameters& c = p.contact;
+  const DepositOptions d;
+  return {{"grains", number_text(double(d.grains))},
+          {"box", number_text(d.box_side * 100, "cm")},
+          {"diameter", number_text(2 * d.radius * 100, "cm")},
+          {"polydispersity", number_text(d.polydispersity)},
+          {"density", number_text(p.density / 1000, "g/cm^3")},
+          {"k-n", number_text(c.k_n * 1000, "g/s^2")},
+          {"restitution-n", number_text(c.restitution_n)},
+          {"restitution-t", number_text(c.restitution_t)},
+          {"kt-over-kn", number_text(c.k_t_over_k_n)},
+          {"mu-s", number_text(c.mu_s)},
+          {"mu-r", number_text(c.mu_r)},
+          {"mu-t", number_text(c.mu_t)},
+          {"beta", number_text(c.beta)},
+          {"dt", number_text(p.dt * 1e6, "us")},
+          {"skin", number_text(p.skin * 100, "cm")},
+          {"gravity", number_text(p.gravity, "m/s^2")},
+          {"seed", number_text(double(d.seed))},
+          {"settled-energy", number_text(d.settled_energy, "J")},
+          {"settling-damping", number_text(d.settling_damping)}};
+}
+
+}  // namespace
+
 RunSettings default_simulate_settings() {
-  RunSettings v;
-  for (const OptionSpec& o : kSimulateOptions)
-    v[o.name] = o.default_value;
+  RunSettings v = library_defaults();
+  for (const OptionSpec& o : kSimulateOptions) {
+    if (o.default_value) v[o.name] = o.default_value;
+  }
   return v;
 }
 

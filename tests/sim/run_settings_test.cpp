@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "granmem/core/error.hpp"
+#include "granmem/sim/simulate_settings.hpp"
 
 namespace granmem {
 namespace {
@@ -47,6 +48,38 @@ TEST(RunSettings, ANewProtocolTakesThePackingFromTheCheckpointAndTheRestAnew) {
       Error);  // the checkpoint lacks a packing option
   EXPECT_NO_THROW(started_from_settings(kRecorded, current, {}, {"mu-s", "lid-pressure"},
                                         {"lid-pressure"}, "trained.h5"));
+}
+
+// The defaults live in the library's structs; the settings' text of them reads back to the
+// same numbers (to the last bit where the unit shown scales exactly).
+TEST(RunSettings, TheDefaultSettingsAreTheLibrarysDefaults) {
+  const RunSettings v = default_simulate_settings();
+  const PhysicsOptions p = physics_from(v), want;
+  EXPECT_EQ(p.contact.k_n, want.contact.k_n);
+  EXPECT_EQ(p.contact.restitution_n, want.contact.restitution_n);
+  EXPECT_EQ(p.contact.restitution_t, want.contact.restitution_t);
+  EXPECT_NEAR(p.contact.k_t_over_k_n, want.contact.k_t_over_k_n, 1e-14);
+  EXPECT_EQ(p.contact.mu_s, want.contact.mu_s);
+  EXPECT_EQ(p.contact.mu_r, want.contact.mu_r);
+  EXPECT_EQ(p.contact.mu_t, want.contact.mu_t);
+  EXPECT_EQ(p.contact.beta, want.contact.beta);
+  EXPECT_EQ(p.wall.mu_s, want.wall.mu_s);  // "same": the grains' friction
+  EXPECT_DOUBLE_EQ(p.density, want.density);
+  EXPECT_DOUBLE_EQ(p.dt, want.dt);
+  EXPECT_DOUBLE_EQ(p.skin, want.skin);
+  EXPECT_EQ(p.gravity, want.gravity);
+  const DepositOptions d = deposit_from(v), dwant;
+  EXPECT_EQ(d.grains, dwant.grains);
+  EXPECT_DOUBLE_EQ(d.radius, dwant.radius);
+  EXPECT_DOUBLE_EQ(d.box_side, dwant.box_side);
+  EXPECT_EQ(d.polydispersity, dwant.polydispersity);
+  EXPECT_EQ(d.seed, dwant.seed);
+  EXPECT_EQ(d.settled_energy, dwant.settled_energy);
+  EXPECT_EQ(d.settling_damping, dwant.settling_damping);
+  // The paper's lid: 1 kg on its 15 x 15 cm box, given as the pressure it exerts.
+  EXPECT_NEAR(d.lid_mass, dwant.lid_mass, 1e-3);
+  EXPECT_EQ(v.at("box"), "15cm");
+  EXPECT_EQ(v.at("dt"), "25us");
 }
 
 }  // namespace

@@ -18,16 +18,19 @@ namespace granmem {
 
 struct OptionSpec {
   const char* name;
-  const char* default_value;
+  const char* default_value;  // nullptr: the library's struct holds it (PhysicsOptions...)
   const char* help;
 };
-// The defaults are the paper's table and protocol.
+// The defaults are the paper's table and protocol; default_simulate_settings() has them
+// all, those of the physics and the deposit taken from PhysicsOptions and DepositOptions
+// (one place for each default).
 extern const OptionSpec kSimulateOptions[];
 extern const std::size_t kSimulateOptionCount;
 // What makes the packing and its physics: fixed for a run, and for runs started from it.
 extern const char* const kPackingOptions[];
 extern const std::size_t kPackingOptionCount;
-// Every option at its default.
+// Every option at its default (the settings' text, e.g. "15cm" for DepositOptions'
+// 0.15 m box).
 RunSettings default_simulate_settings();
 
 // A setting read as a plain number, a quantity in SI (a bare number in `default_unit`), a

@@ -5,6 +5,7 @@
 #include "commands.hpp"
 #include "git_commit.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/version.hpp"
 #include "simulation_settings.hpp"
 
@@ -51,6 +52,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("granmem ") + granmem::kVersion + " (commit " +
                                         granmem::kGitCommit + ")");
   app.set_config("--config", "", "TOML file of options, one [section] per command");
+  app.add_option("--author",
+                 "who made the files: recorded in every store written "
+                 "(H5MD /h5md/author; default the login name)")
+      ->each([](const std::string& name) { granmem::set_default_author(name); });
   app.require_subcommand(1);
   app.fallthrough();                                        // --config may follow the command name
   app.allow_config_extras(CLI::config_extras_mode::error);  // a mistyped key is an error

@@ -137,12 +137,22 @@ std::vector<T> frame_labels(const h5::File& file, const std::string& path, hsize
   return out;
 }
 
+std::string& author_given() {
+  static std::string name;
+  return name;
+}
+
 std::string default_author() {
+  if (!author_given().empty()) return author_given();
   const char* user = std::getenv("USER");
   return user && *user ? user : "unknown";
 }
 
 }  // namespace
+
+void set_default_author(const std::string& name) {
+  author_given() = name;
+}
 
 struct TrajectoryWriter::Impl {
   RunHeader header;

@@ -25,7 +25,7 @@ __version__ = _granmem.__version__
 
 __all__ = ["Error", "read_stack", "write_tiff", "render", "locate", "link", "read_run",
            "read_tracks", "write_run", "motion", "analyze", "simulate", "readout", "compare",
-           "calibrate"]
+           "calibrate", "set_author"]
 
 
 def _frame(columns, units=None, **attrs):
@@ -146,6 +146,12 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
         max_displacement != "auto" else "auto", int(memory), bool(collective_motion), container,
         container_size, progress)
     return _frame(columns, units, length_unit=length_unit, summary=summary)
+
+
+def set_author(name):
+    """Who made the files: recorded in every store written from now on (H5MD's
+    /h5md/author, as ``granmem --author``); the login name until set."""
+    _granmem.set_author(str(name))
 
 
 def info(path):

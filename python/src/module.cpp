@@ -859,6 +859,7 @@ PYBIND11_MODULE(_granmem, m) {
 
   m.def(
       "info", [](const std::filesystem::path& path) { return run_info(path); }, py::arg("path"));
+  m.def("set_author", &set_default_author, py::arg("name"));
   m.def("read_stack", &read_stack_py, py::arg("path"), py::arg("dataset") = "",
         py::arg("region") = py::none());
   m.def("write_tiff", &write_tiff_py, py::arg("stack"), py::arg("path"),

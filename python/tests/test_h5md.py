@@ -103,6 +103,16 @@ def test_a_simulated_run_conforms(tmp_path):
         assert "unit" not in f["observables/packing_fraction/value"].attrs  # dimensionless
 
 
+def test_the_author_set_is_recorded(tmp_path):
+    granmem.set_author("A. Lab")
+    try:
+        granmem.simulate(out=tmp_path / "run.h5", cycles=1, **TINY)
+    finally:
+        granmem.set_author("")  # the login name again, for the other tests
+    with h5py.File(tmp_path / "run.h5", "r") as f:
+        assert f["h5md/author"].attrs["name"] == b"A. Lab"
+
+
 def test_a_tracked_run_in_voxels_and_cycles_conforms(tmp_path, cli):
     (tmp_path / "t.csv").write_text("frame,particle,x,y,z,ax,ay,az\n0,1,1,2,3,0,0,1\n"
                                     "0,2,4,5,6,1,0,0\n1,1,1.5,2,3,0,0,1\n1,2,4,5,6.5,1,0,0\n")

@@ -5,6 +5,7 @@
 
 #include <fstream>
 
+#include "granmem/core/trajectory_store.hpp"
 #include "run_granmem.hpp"
 
 namespace granmem::testing {
@@ -31,6 +32,19 @@ TEST_F(Cli, UsageErrorsExitTwo) {
   }
   std::ofstream(in_work("not_hdf5.h5")) << "text\n";  // exists: the job itself fails
   EXPECT_EQ(granmem({"info", "not_hdf5.h5"}).exit_code, 1);
+}
+
+// Whoever made a file is recorded in it (H5MD's /h5md/author), given before or after the
+// command's name; the login name when not given.
+TEST_F(Cli, TheAuthorIsRecordedInTheStoresWritten) {
+  std::ofstream(in_work("t.csv")) << "frame,particle,x,y,z\n0,0,1,2,3\n1,0,1,2,4\n";
+  granmem_ok({"--author", "A. Lab", "import", "t.csv", "--length-unit", "mm", "--out", "a.h5"});
+  EXPECT_EQ(TrajectoryReader(in_work("a.h5")).header().author, "A. Lab");
+  granmem_ok({"import", "t.csv", "--length-unit", "mm", "--out", "b.h5", "--author", "B. Lab"});
+  EXPECT_EQ(TrajectoryReader(in_work("b.h5")).header().author, "B. Lab");
+  granmem_ok({"import", "t.csv", "--length-unit", "mm", "--out", "c.h5"});
+  EXPECT_FALSE(TrajectoryReader(in_work("c.h5")).header().author.empty());
+  EXPECT_NE(TrajectoryReader(in_work("c.h5")).header().author, "B. Lab");
 }
 
 }  // namespace

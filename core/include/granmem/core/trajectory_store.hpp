@@ -27,6 +27,10 @@ namespace granmem {
 // commit(), it leaves nothing behind and any existing file of that name untouched.
 // For long runs, publish() puts a complete copy of what is written so far in place and
 // goes on, and resume() continues a run published or committed before.
+// The author written into stores whose header names none (/h5md/author): this name
+// (`granmem --author`), else the login ($USER), else "unknown". Set it before writing.
+void set_default_author(const std::string& name);
+
 class TrajectoryWriter {
  public:
   TrajectoryWriter(const std::filesystem::path& path, RunHeader header);

@@ -1,14 +1,16 @@
 #include "granmem/sim/lammps_engine.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <fcntl.h>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -18,7 +20,6 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/lammps_dump.hpp"
 #include "granmem/core/trajectory_store.hpp"
-#include "granmem/sim/deposit.hpp"
 #include "granmem/sim/lammps_data.hpp"
 
 namespace granmem {
@@ -153,20 +154,28 @@ std::string lammps_error(const std::filesystem::path& out) {
 
 // The per-cycle lines: cycle -> (full-compression force, end force, lid height, kinetic
 // energy, contacts per grain), CGS; a cycle written twice (a run resumed from an earlier
-// restart) keeps its newer line.
-std::map<std::int64_t, std::array<double, 5>> read_observed(const std::filesystem::path& path) {
+// restart) keeps its newer line. While LAMMPS runs (`partial`) a line it is writing ends
+// the reading; after it, a line that is not one is an Error.
+std::map<std::int64_t, std::array<double, 5>> read_observed(const std::filesystem::path& path,
+                                                            bool partial = false) {
   std::map<std::int64_t, std::array<double, 5>> rows;
   std::ifstream in(path);
   std::string word, line;
   while (std::getline(in, line)) {
     std::istringstream s(line);
     std::int64_t cycle = 0;
-    std::array<std::string, 5> v;
-    if (!(s >> word >> cycle >> v[0] >> v[1] >> v[2] >> v[3] >> v[4]) || word != "cycle") {
-      throw Error(path.string() + ": not a line of LAMMPS's cycles: '" + line + "'");
+    std::array<std::string, 5> text;
+    std::array<double, 5> value{};
+    bool ok = bool(s >> word >> cycle >> text[0] >> text[1] >> text[2] >> text[3] >> text[4]) &&
+              word == "cycle";
+    for (std::size_t k = 0; ok && k < text.size(); ++k) {
+      char* end = nullptr;
+      value[k] = std::strtod(text[k].c_str(), &end);  // nan and inf as C reads them
+      ok = end == text[k].c_str() + text[k].size();
     }
-    for (std::size_t k = 0; k < v.size(); ++k)
-      rows[cycle][k] = v[k] == "nan" ? std::nan("") : std::stod(v[k]);
+    if (!ok && partial) break;
+    if (!ok) throw Error(path.string() + ": not a line of LAMMPS's cycles: '" + line + "'");
+    rows[cycle] = value;
   }
   return rows;
 }
@@ -210,7 +219,7 @@ int wait_for(pid_t pid, const std::filesystem::path& observed, std::int64_t firs
     const auto now = std::chrono::steady_clock::now();
     if (!progress || now - last_report < std::chrono::seconds(2)) continue;
     last_report = now;
-    const auto rows = read_observed(observed);
+    const auto rows = read_observed(observed, true);
     const std::int64_t done = rows.empty() ? first : std::max(first, rows.rbegin()->first);
     if (done == reported) continue;
     reported = done;
@@ -291,6 +300,21 @@ void write_store(const Simulation& sim, const CyclicOptions& o, const RunPlan& p
   writer.commit();
 }
 
+// A program that execvp would start: a path to an executable file, or a name found so on
+// $PATH.
+bool can_run(const std::string& program) {
+  if (program.empty()) return false;
+  if (program.find('/') != std::string::npos) return access(program.c_str(), X_OK) == 0;
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path ? path : "/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    const std::string candidate = (dir.empty() ? "." : dir) + "/" + program;
+    if (access(candidate.c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void check_lammps_protocol(const CyclicOptions& o, bool one_grain_size, bool lid) {
@@ -315,8 +339,15 @@ std::filesystem::path lammps_folder(const std::filesystem::path& out) {
 void LammpsEngineOptions::validate() const {
   if (folder.empty()) throw Error("--engine lammps: no folder for LAMMPS's files");
   if (ranks < 1) throw Error("--ranks " + std::to_string(ranks) + ": expected 1 or more");
-  if (lmp.empty()) throw Error("--lammps: expected the LAMMPS executable (lmp)");
-  if (ranks > 1 && mpirun.empty()) throw Error("--ranks needs an MPI launcher (mpirun)");
+  if (!can_run(lmp)) {
+    throw Error("--lammps '" + lmp +
+                "': no such program (LAMMPS with the GRANULAR and DIPOLE packages; Debian: "
+                "apt-get install lammps)");
+  }
+  if (ranks > 1 && !can_run(mpirun)) {
+    throw Error("--ranks " + std::to_string(ranks) + ": no '" + mpirun +
+                "' to start the ranks (Debian: apt-get install openmpi-bin)");
+  }
 }
 
 std::pair<std::filesystem::path, std::int64_t> newest_lammps_restart(

@@ -127,9 +127,9 @@ std::optional<LammpsEngineOptions> lammps_engine_from(const RunSettings& v, cons
   e.ranks = int(std::min<std::int64_t>(setting_whole(v, "ranks"), 1 << 20));
   e.lmp = v.at("lammps");
   e.resume = resume;
-  e.validate();
   const bool lid = sim ? sim->container().lid.present : d.lid_mass > 0;
   check_lammps_protocol(c, sim ? true : d.polydispersity == 0, lid);  // sizes: checked on the run
+  e.validate();
   return e;
 }
 

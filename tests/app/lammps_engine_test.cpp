@@ -122,6 +122,8 @@ TEST_F(LammpsEngine, WhatLammpsCannotRunIsRefusedBeforeAnyWork) {
   expect_clean_failure(with(small_run("p.h5", "1"), {"--full-compression", "yes"}),
                        {"--engine lammps", "--full-compression", "--engine granmem"});
   expect_clean_failure(with(small_run("p.h5", "1"), {"--ranks", "0"}), {"--ranks 0", "1 or more"});
+  expect_clean_failure(with(small_run("p.h5", "1"), {"--lammps", "no-such-lmp"}),
+                       {"--lammps 'no-such-lmp'", "no such program", "apt-get install lammps"});
   std::vector<std::string> other = small_run("p.h5", "1");
   other.insert(other.end(), {"--engine", "gromacs"});
   expect_clean_failure(other, {"--engine gromacs", "granmem or lammps"});

@@ -27,13 +27,19 @@ step "1/5 the sample table of tracked grains"
 
 step "2/5 pseudo-experiment: DEM at mu_s = $TRUE_MU_S (seed 101), scans of each cycle's end"
 "$granmem" --config $config simulate --mu-s $TRUE_MU_S --seed 101 --out "$out/experiment_dem.h5"
-for cycle in 0 1 2; do
-  "$granmem" --config $config render "$out/experiment_dem.h5" --frame $cycle \
-    --seed $((cycle + 1)) --out "$out/scans/scan$cycle.tif" --truth "$out/scans/truth$cycle.csv"
+render() {  # one scan of the end of cycle $1
+  "$granmem" --config $config render "$out/experiment_dem.h5" --frame "$1" --seed $(($1 + 1)) \
+    --out "$out/scans/scan$1.tif" --truth "$out/scans/truth$1.csv" > "$out/scans/render$1.log"
+}
+for pair in "0 1" "2 3"; do  # two at a time, one per core
+  pids=()
+  for cycle in $pair; do render "$cycle" & pids+=($!); done
+  for pid in "${pids[@]}"; do wait "$pid"; done
 done
 
 step "3/5 tracking the scans (locate, link) and analysing the tracks"
-"$granmem" track "$out"/scans/scan*.tif --diameter 5mm --out "$out/tracks.h5" \
+"$granmem" track "$out"/scans/scan*.tif --diameter 5mm --container-size 5,5,15cm \
+  --out "$out/tracks.h5" \
   --analyze "$out/tracks_analysis"
 
 step "4/5 calibrating the DEM's friction on the tracked scans"

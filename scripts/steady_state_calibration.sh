@@ -6,7 +6,11 @@
 # A = 1 %, 40 cycles, window 31:40 (the last 10, as the paper).
 #
 #   scripts/steady_state_calibration.sh [--out DIR] [--granmem BIN] [--mu-s LIST]
-#                                       [--replicas N] [--joint]
+#                                       [--replicas N] [--joint] [--grains N]
+#                                       [--cycles C] [--window F:L] [--pseudo LIST]
+#
+# --grains, --cycles and --window change the protocol (default 1500, 40, 31:40); --pseudo
+# the pseudo-experiments, as "mu_s:seed,mu_s:seed,..." (default 0.15:7,0.25:8,0.35:9,0.1:10).
 #
 # Pseudo-experiments (mu_s, seed): (0.15, 7), (0.25, 8), (0.35, 9), (0.1, 10). The twin:
 # --mu-s (default 0.05,0.1,0.2,0.4) x --replicas packings (default 3: seeds 1-3) = 12
@@ -22,6 +26,10 @@ granmem="$root/build/app/granmem"
 mus="0.05,0.1,0.2,0.4"
 replicas=3
 joint=0
+grains=1500
+cycles=40
+window=31:40
+pseudos="0.15:7,0.25:8,0.35:9,0.1:10"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --out) out="$2"; shift ;;
@@ -29,7 +37,11 @@ while [[ $# -gt 0 ]]; do
     --mu-s) mus="$2"; shift ;;
     --replicas) replicas="$2"; shift ;;
     --joint) joint=1 ;;
-    -h|--help) sed -n '2,17p' "$0"; exit 0 ;;
+    --grains) grains="$2"; shift ;;
+    --cycles) cycles="$2"; shift ;;
+    --window) window="$2"; shift ;;
+    --pseudo) pseudos="$2"; shift ;;
+    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     *) echo "steady_state_calibration.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
@@ -37,13 +49,15 @@ done
 [[ -x $granmem ]] || { echo "steady_state_calibration.sh: no granmem at $granmem" >&2; exit 1; }
 mkdir -p "$out/runs"
 cd "$out"
-cat > protocol.toml <<'EOF'
-# 1,500 grains at the paper's lid pressure (the default 436 Pa), A = 1 %, 40 cycles
+cat > protocol.toml <<EOF
+# $grains grains at the paper's lid pressure (the default 436 Pa), A = 1 %, $cycles cycles
 [simulate]
-grains = "1500"
+grains = "$grains"
 box = "5cm"
 amplitude = "1%"
-cycles = "40"
+cycles = "$cycles"
+[calibrate]
+window = "$window"
 EOF
 
 pseudo() {  # name mu_s seed: simulated once, resumed from its checkpoint if stopped
@@ -58,11 +72,13 @@ pseudo() {  # name mu_s seed: simulated once, resumed from its checkpoint if sto
 }
 export -f pseudo
 export granmem
-printf '%s\n' "pseudo_0.15 0.15 7" "pseudo_0.25 0.25 8" "pseudo_0.35 0.35 9" "pseudo_0.1 0.1 10" |
+names=()
+for p in ${pseudos//,/ }; do names+=("pseudo_${p%%:*}_seed_${p##*:}"); done
+for p in ${pseudos//,/ }; do echo "pseudo_${p%%:*}_seed_${p##*:} ${p%%:*} ${p##*:}"; done |
   xargs -P 2 -L 1 bash -c 'pseudo "$@"' _
 
 echo "experiment,mu_s_true,mu_s,ci95_low,ci95_high,n_simulations" > fits.csv.tmp
-for p in pseudo_0.15 pseudo_0.25 pseudo_0.35 pseudo_0.1; do
+for p in "${names[@]}"; do
   mkdir -p "fit_$p"
   ln -sfn ../runs "fit_$p/runs"
   "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "fit_$p" \
@@ -78,7 +94,7 @@ mv fits.csv.tmp fits.csv
 cat fits.csv
 
 if [[ $joint -eq 1 ]]; then
-  "$granmem" --config protocol.toml calibrate --experiment pseudo_0.15.h5 --out joint \
+  "$granmem" --config protocol.toml calibrate --experiment "${names[0]}.h5" --out joint \
     --fit mu_s,mu_r --mu-s 0.05,0.12,0.3 --mu-r 0.004,0.012,0.036 --replicas 2 \
     --observables steady-state --threads 2 2> joint.log | tee joint.txt
 fi

@@ -184,7 +184,7 @@ std::string steady_state_label(const std::string& name) {
 }
 
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure) {
+                         const StructureOptions& structure, std::optional<double> grain_radius) {
   const std::int64_t first = observed.window.first, last = observed.window.second;
   auto in_window = [&](std::int64_t c) { return c >= first && c <= last; };
   SteadyState s;
@@ -219,14 +219,17 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
   // The container's cross-section, in the positions' unit (NaN: no box).
   const auto& h = run.header();
   const double section = h.box ? h.box->edges(0) * h.box->edges(1) : kNaN;
+  const std::vector<double> radius =
+      grain_radius ? std::vector<double>(h.id.size(), *grain_radius / metres_per_length(run))
+                   : h.radius;
   for (std::size_t t = 0; t < run.frame_count(); ++t) {
     if (!in_window(run.steps()[t])) continue;
     const Vectors3 position = run.read_frame(t).position;
-    const PackingStructure p = packing_structure(position, h.radius, structure);
+    const PackingStructure p = packing_structure(position, radius, structure);
     cycles.push_back(run.steps()[t]);
     packing.push_back(p.packing_fraction);
     coordination.push_back(p.coordination);
-    from_height.push_back(height_packing_fraction(position, h.radius, section));
+    from_height.push_back(height_packing_fraction(position, radius, section));
   }
   add("bulk_packing_fraction", cycles, packing, true);
   add("coordination", cycles, coordination, true);

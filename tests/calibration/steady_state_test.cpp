@@ -76,6 +76,29 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
 }
 
+// A scan's located radii come out small (blur, threshold): measured at the grains' known
+// radius, the structure is the lattice's again; at the located radii it is not.
+TEST_F(SteadyStateTest, TheStructureIsMeasuredAtTheGrainsKnownRadiusWhenGiven) {
+  Trajectories located = cubic_run();
+  for (double& r : located.header.radius)
+    r *= 0.95;
+  write_trajectories(path("scan.h5"), located);
+  const TrajectoryReader run(path("scan.h5"));
+  ObservableOptions o;
+  o.window = {3, 4};
+  const CycleObservables observed = cycle_observables(run, o);
+  const SteadyState at_located = steady_state(run, observed);
+  // 8 layers of grains of radius 0.475 mm, 7 + 0.95 mm from bottom to top, on 8 x 8 mm
+  EXPECT_NEAR(at_located["height_packing_fraction"],
+              512 * 4.0 / 3 * M_PI * std::pow(0.475, 3) / (64 * 7.95), 1e-12);
+  EXPECT_DOUBLE_EQ(at_located["coordination"], 0);  // 5 % gaps: no grain touches
+  const SteadyState at_known = steady_state(run, observed, {}, 0.5e-3);  // m
+  EXPECT_NEAR(at_known["bulk_packing_fraction"], M_PI / 6, 1e-12);
+  EXPECT_DOUBLE_EQ(at_known["coordination"], 6);
+  EXPECT_NEAR(at_known["height_packing_fraction"], M_PI / 6, 1e-12);
+  EXPECT_NEAR(at_known["rot_disp"], kTurn / 2, 1e-12);  // rotations do not use the radius
+}
+
 // compare's options (the window and wall distance it pools these observables with),
 // checked before either run is read: the defaults with a folder pass.
 TEST(CompareOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -91,8 +92,12 @@ struct SteadyState {
   double operator[](const std::string& name) const;
   double drift_of(const std::string& name) const;
 };
+// `grain_radius` (m): measure the structure with every grain at this radius instead of the
+// store's radii (a scan's located radii are biased by its blur and threshold, and a packing
+// fraction goes as r^3).
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure = {});
+                         const StructureOptions& structure = {},
+                         std::optional<double> grain_radius = {});
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at
 // full compression (N)"); the name itself for one it does not know.
 std::string steady_state_label(const std::string& name);

@@ -44,7 +44,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->capture_default_str();
   cmd->add_option("--window", args->window,
                   "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
-                  "experiment's last 10");
+                  "experiment's last 10; steady-state: auto, the longest window ending there "
+                  "over which the twin's runs are steady");
   cmd->add_option("--noise", args->noise,
                   "locating noise added to the simulated positions: none, fit, a value in voxels, "
                   "or auto (fit for scans, none for simulations)")
@@ -125,7 +126,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.observables = args->observables == "steady-state" ? CalibrationObservables::steady_state
                                                         : CalibrationObservables::displacements;
     o.only = parse_names(args->only);
-    if (!args->window.empty()) o.window = parse_int_range(args->window, "--window");
+    if (!args->window.empty()) o.set_window(args->window, "--window");
     o.noise = args->noise;
     o.per_cycle = args->summaries == "per-cycle";
     o.wall_distance = parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");

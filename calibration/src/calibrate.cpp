@@ -14,6 +14,7 @@
 #include "granmem/calibration/figures.hpp"
 #include "granmem/calibration/friction_fit.hpp"
 #include "granmem/calibration/observable_fit.hpp"
+#include "granmem/calibration/steady_window.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/json_file.hpp"
 #include "granmem/core/option_values.hpp"
@@ -183,6 +184,40 @@ class Twin {
 
   ObservableOptions observe;
   CycleObservables measured;
+
+  // --window auto: the window moved to where the twin's runs are steady (they hold every
+  // cycle up to the experiment's last, the window's end). Returns the line that says where.
+  std::string choose_window(const std::vector<FrictionRunSpec>& specs) {
+    std::vector<ObservableSeries> runs;
+    std::vector<std::size_t> cell;  // one per friction (pair)
+    std::map<std::pair<double, double>, std::size_t> cells;
+    for (const FrictionRunSpec& spec : specs) {
+      const TrajectoryReader r(path(spec));
+      runs.push_back(observable_series(r, cycle_observables(r, observe)));
+      cell.push_back(cells.emplace(std::pair{spec.mu_s, spec.mu_r}, cells.size()).first->second);
+    }
+    std::vector<std::string> names;
+    for (const std::string& name : measured_steady_state().names)
+      if (o_.only.empty() || std::count(o_.only.begin(), o_.only.end(), name))
+        names.push_back(name);
+    SteadyWindowOptions options;
+    options.last = observe.window.second;
+    const SteadyWindow w = choose_steady_window(runs, cell, names, options);
+    observe.window = w.window;
+    measured = measured_observables(experiment_, observe);
+    std::ostringstream line;
+    line << "window from the twin's runs: cycles " << w.window.first << "-" << w.window.second;
+    if (w.steady) {
+      line << " (every observable's change across it within one packing's scatter)";
+    } else {
+      line << ": not steady by cycle " << w.window.second << " (" << w.unsteady
+           << " still changes by " << w.change << " across its last " << options.min_cycles
+           << " cycles, one packing's scatter " << w.scatter << "); the last "
+           << w.window.second - w.window.first + 1 << " cycles";
+    }
+    say(line.str());
+    return line.str();
+  }
 
   // The experiment's steady state. Grains known to be alike (the twin's are, without
   // polydispersity) are measured at the twin's radius: a scan's located radii come out
@@ -745,6 +780,22 @@ void CalibrateOptions::validate() const {
   }
   if (!(wall_distance >= 0)) throw Error("--wall-distance: expected a length >= 0");
   if (window && window->first < 1) throw Error("--window: cycles start at 1");
+  if (auto_window && !steady) {
+    throw Error(
+        "--window auto: only with --observables steady-state (a steady window is "
+        "where its observables stop changing)");
+  }
+  if (auto_window && replicas < 2) {
+    throw Error(
+        "--window auto: needs --replicas 2 or more (one packing's scatter is what a "
+        "change is measured against)");
+  }
+}
+
+void CalibrateOptions::set_window(const std::string& text, const std::string& option) {
+  auto_window = text == "auto";
+  window.reset();
+  if (!auto_window) window = parse_int_range(text, option);
 }
 
 CalibrateSummary calibrate(const CalibrateOptions& options) {
@@ -765,6 +816,7 @@ CalibrateSummary calibrate(const CalibrateOptions& options) {
   const std::vector<FrictionRunSpec> specs = twin.design();
   twin.run(specs);
   std::ostringstream report;
+  if (options.auto_window) report << twin.choose_window(specs) << "\n";
   if (options.joint()) {
     fit_joint(twin, specs, s, report);
   } else if (steady) {

@@ -183,22 +183,62 @@ std::string steady_state_label(const std::string& name) {
   return it == labels.end() ? name : it->second;
 }
 
-SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure, std::optional<double> grain_radius) {
-  const std::int64_t first = observed.window.first, last = observed.window.second;
-  auto in_window = [&](std::int64_t c) { return c >= first && c <= last; };
+ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
+                                   const StructureOptions& structure,
+                                   std::optional<double> grain_radius, CycleRange cycles) {
+  const auto in_range = [&](std::int64_t c) {
+    return cycles.second == 0 || (c >= cycles.first && c <= cycles.second);
+  };
+  ObservableSeries s;
+  if (std::any_of(observed.mean_rot_disp.begin(), observed.mean_rot_disp.end(),
+                  [](double v) { return std::isfinite(v); })) {
+    s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
+  }
+  ObservableSeries::Entry packing{"bulk_packing_fraction", {}, {}, true},
+      coordination{"coordination", {}, {}, true},
+      from_height{"height_packing_fraction", {}, {}, true};
+  // The container's cross-section, in the positions' unit (NaN: no box).
+  const auto& h = run.header();
+  const double section = h.box ? h.box->edges(0) * h.box->edges(1) : kNaN;
+  const std::vector<double> radius =
+      grain_radius ? std::vector<double>(h.id.size(), *grain_radius / metres_per_length(run))
+                   : h.radius;
+  for (std::size_t t = 0; t < run.frame_count(); ++t) {
+    const std::int64_t c = run.steps()[t];
+    if (!in_range(c)) continue;
+    const Vectors3 position = run.read_frame(t).position;
+    const PackingStructure p = packing_structure(position, radius, structure);
+    for (auto* e : {&packing, &coordination, &from_height})
+      e->cycle.push_back(c);
+    packing.value.push_back(p.packing_fraction);
+    coordination.value.push_back(p.coordination);
+    from_height.value.push_back(height_packing_fraction(position, radius, section));
+  }
+  s.entries.push_back(std::move(packing));
+  s.entries.push_back(std::move(coordination));
+  if (h.box) s.entries.push_back(std::move(from_height));
+  for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
+    const auto it = run.observables().find(name);
+    if (it != run.observables().end()) {
+      s.entries.push_back({name, it->second.step, it->second.value, false});
+    }
+  }
+  return s;
+}
+
+SteadyState window_means(const ObservableSeries& series, CycleRange window) {
+  const auto [first, last] = window;
   SteadyState s;
-  // The window's mean, and its least-squares change across the window (slope x cycles).
-  auto add = [&](const std::string& name, const std::vector<std::int64_t>& cycle,
-                 const std::vector<double>& value, bool always) {
+  for (const ObservableSeries::Entry& e : series.entries) {
     std::vector<double> c, v;
-    for (std::size_t k = 0; k < cycle.size() && k < value.size(); ++k) {
-      if (in_window(cycle[k]) && std::isfinite(value[k])) {
-        c.push_back(double(cycle[k]));
-        v.push_back(value[k]);
+    for (std::size_t k = 0; k < e.cycle.size() && k < e.value.size(); ++k) {
+      if (e.cycle[k] >= first && e.cycle[k] <= last && std::isfinite(e.value[k])) {
+        c.push_back(double(e.cycle[k]));
+        v.push_back(e.value[k]);
       }
     }
-    if (v.empty() && !always) return;
+    if (v.empty() && !e.always) continue;
+    // The window's mean, and its least-squares change across the window (slope x cycles).
     const double n = double(v.size());
     double mc = 0, mv = 0, scc = 0, scv = 0;
     for (std::size_t k = 0; k < v.size(); ++k) {
@@ -209,36 +249,17 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
       scc += (c[k] - mc) * (c[k] - mc);
       scv += (c[k] - mc) * (v[k] - mv);
     }
-    s.names.push_back(name);
+    s.names.push_back(e.name);
     s.values.push_back(v.empty() ? kNaN : mv);
     s.drift.push_back(scc > 0 ? scv / scc * double(last - first) : kNaN);
-  };
-  add("rot_disp", observed.cycle, observed.mean_rot_disp, false);
-  std::vector<std::int64_t> cycles;
-  std::vector<double> packing, coordination, from_height;
-  // The container's cross-section, in the positions' unit (NaN: no box).
-  const auto& h = run.header();
-  const double section = h.box ? h.box->edges(0) * h.box->edges(1) : kNaN;
-  const std::vector<double> radius =
-      grain_radius ? std::vector<double>(h.id.size(), *grain_radius / metres_per_length(run))
-                   : h.radius;
-  for (std::size_t t = 0; t < run.frame_count(); ++t) {
-    if (!in_window(run.steps()[t])) continue;
-    const Vectors3 position = run.read_frame(t).position;
-    const PackingStructure p = packing_structure(position, radius, structure);
-    cycles.push_back(run.steps()[t]);
-    packing.push_back(p.packing_fraction);
-    coordination.push_back(p.coordination);
-    from_height.push_back(height_packing_fraction(position, radius, section));
-  }
-  add("bulk_packing_fraction", cycles, packing, true);
-  add("coordination", cycles, coordination, true);
-  if (h.box) add("height_packing_fraction", cycles, from_height, true);
-  for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
-    const auto it = run.observables().find(name);
-    if (it != run.observables().end()) add(name, it->second.step, it->second.value, false);
   }
   return s;
+}
+
+SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
+                         const StructureOptions& structure, std::optional<double> grain_radius) {
+  return window_means(observable_series(run, observed, structure, grain_radius, observed.window),
+                      observed.window);
 }
 
 }  // namespace granmem

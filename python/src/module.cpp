@@ -756,7 +756,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.observables = observables == "steady-state" ? CalibrationObservables::steady_state
                                                 : CalibrationObservables::displacements;
   o.only = only;
-  if (window) o.window = parse_int_range(*window, "window");
+  if (window) o.set_window(*window, "window");
   o.noise = noise;
   if (summaries != "pooled" && summaries != "per-cycle") {
     throw Error("summaries '" + summaries + "': expected pooled or per-cycle");

@@ -71,6 +71,10 @@ TEST_F(Calibrate, RefusesBadInput) {
   expect_clean_failure(calibrate({}, other), {"exp.h5", "amplitude 5%", "twin has 3%"});
   expect_clean_failure(calibrate({"--noise", "fit"}), {"--noise", "voxel size"});
   expect_clean_failure(calibrate({"--fit-only"}), {"--fit-only", "steady-state"});
+  expect_clean_failure(calibrate({"--window", "auto"}), {"--window auto", "steady-state"});
+  expect_clean_failure(
+      calibrate({"--window", "auto", "--observables", "steady-state", "--replicas", "1"}),
+      {"--window auto", "--replicas 2"});
 }
 
 TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
@@ -119,6 +123,14 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
                         "cal/observable_fit.dat", "cal/steady_state_runs.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(in_work(f))) << f;
   }
+  // The window from the runs themselves (the same runs, reused): three cycles after the
+  // deposit are no steady state at this size, and it says so.
+  const RunResult chosen = granmem_ok(calibrate({"--window", "auto", "--mu-s", "0.05,0.1,0.2,0.4",
+                                                 "--observables", "steady-state", "--fit-only"}));
+  EXPECT_NE(chosen.err.find("reusing 8 finished runs"), std::string::npos) << chosen.err;
+  EXPECT_NE(chosen.out.find("window from the twin's runs: cycles "), std::string::npos)
+      << chosen.out;
+  expect_fit_in_its_interval(read_text(in_work("cal/summary.json")));
   // A scan has no lid: asked by name for what the experiment lacks is one clear error.
   expect_clean_failure(calibrate({"--window", "2:3", "--mu-s", "0.05,0.1,0.2,0.4", "--observables",
                                   "steady-state", "--only", "lid_angle"}),

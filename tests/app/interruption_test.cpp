@@ -75,6 +75,25 @@ class Interruption : public GranmemTest {
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
 
+  // Kills `child` with SIGKILL once a finished store named `prefix`*.h5 is in `folder`
+  // (a sweep's first finished run); false if none appears within two minutes.
+  bool kill_after_a_finished_run(pid_t child, const fs::path& folder, const std::string& prefix) {
+    bool finished_one = false;
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+    while (!finished_one && std::chrono::steady_clock::now() < give_up) {
+      std::error_code ec;
+      for (const auto& e : fs::directory_iterator(folder, ec)) {
+        finished_one = finished_one || (e.path().filename().string().rfind(prefix, 0) == 0 &&
+                                        e.path().extension() == ".h5");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (!finished_one) return false;
+    kill(child, SIGKILL);
+    EXPECT_EQ(wait_exit(child), 128 + SIGKILL);
+    return true;
+  }
+
   std::vector<std::string> temporaries() const {
     std::vector<std::string> left;
     for (const auto& e : fs::directory_iterator(work())) {
@@ -158,20 +177,7 @@ TEST_F(Interruption, AKilledReadoutSweepReusesItsFinishedRunsAndEndsTheSame) {
   };
   granmem_ok(sweep("whole"));
   const pid_t child = start(sweep("killed"));
-  bool finished_one = false;
-  const auto give_up = std::chrono::steady_clock::now() + std::chrono::minutes(2);
-  while (!finished_one && std::chrono::steady_clock::now() < give_up) {
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(in_work("killed"), ec)) {
-      const std::string name = e.path().filename().string();
-      finished_one = finished_one || (name.rfind("readout_", 0) == 0 && name.size() > 3 &&
-                                      name.substr(name.size() - 3) == ".h5");
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  ASSERT_TRUE(finished_one) << "no run finished";
-  kill(child, SIGKILL);
-  EXPECT_EQ(wait_exit(child), 128 + SIGKILL);
+  ASSERT_TRUE(kill_after_a_finished_run(child, in_work("killed"), "readout_")) << "no run finished";
   EXPECT_FALSE(fs::exists(in_work("killed") / "readout.csv"));  // killed before the end
 
   const RunResult again = granmem_ok(sweep("killed"));
@@ -196,6 +202,46 @@ TEST_F(Interruption, AKilledReadoutSweepReusesItsFinishedRunsAndEndsTheSame) {
     if (file.extension() == ".h5") {
       EXPECT_TRUE(fs::exists(fs::path(file).replace_extension(".xmf"))) << file;
     }
+  }
+  EXPECT_TRUE(left.empty()) << left.front();
+}
+
+// A calibration killed while its twin runs: the next call reuses the runs that finished,
+// redoes the rest, and fits what an unstopped call fits, to the last digit.
+TEST_F(Interruption, AKilledCalibrationReusesItsFinishedRunsAndFitsTheSame) {
+  const std::vector<std::string> twin{"--grains",    "60", "--box",    "2cm",
+                                      "--amplitude", "2%", "--period", "0.5s"};
+  std::vector<std::string> experiment{"simulate", "--cycles", "2",      "--seed",    "7", "--mu-s",
+                                      "0.2",      "--out",    "exp.h5", "--threads", "1"};
+  experiment.insert(experiment.end(), twin.begin(), twin.end());
+  granmem_ok(experiment);
+  auto calibrate = [&](const std::string& out) {
+    std::vector<std::string> a{
+        "calibrate",        "--experiment",  "exp.h5",       "--out",      out,        "--mu-s",
+        "0.05,0.1,0.2,0.4", "--observables", "steady-state", "--fit-only", "--window", "1:2"};
+    a.insert(a.end(), twin.begin(), twin.end());
+    return a;
+  };
+  granmem_ok(calibrate("whole"));
+  const pid_t child = start(calibrate("killed"));
+  ASSERT_TRUE(kill_after_a_finished_run(child, in_work("killed") / "runs", "mu_s_"))
+      << "no run finished";
+  EXPECT_FALSE(fs::exists(in_work("killed") / "summary.json"));  // killed before the fit
+
+  const RunResult again = granmem_ok(calibrate("killed"));
+  const std::size_t at = again.err.find("reusing ");
+  ASSERT_NE(at, std::string::npos) << again.err;
+  const int reused = std::stoi(again.err.substr(at + 8));
+  EXPECT_GE(reused, 1) << again.err;
+  EXPECT_LT(reused, 8) << again.err;
+  const std::string fitted = again.out.substr(again.out.find("mu_s = "));
+  const RunResult whole_again = granmem_ok(calibrate("whole"));  // every run reused
+  EXPECT_EQ(fitted.substr(0, fitted.find('\n')),
+            whole_again.out.substr(whole_again.out.find("mu_s = ")).substr(0, fitted.find('\n')));
+  std::vector<std::string> left;
+  for (const auto& e : fs::recursive_directory_iterator(in_work("killed"))) {
+    if (e.path().filename().string().find(".tmp-") != std::string::npos)
+      left.push_back(e.path().filename().string());
   }
   EXPECT_TRUE(left.empty()) << left.front();
 }

@@ -40,6 +40,10 @@ struct CalibrateOptions {
   std::vector<std::string> only;  // steady state: these observables only (default all)
   // Cycles whose observables are compared; default the experiment's last 10.
   std::optional<std::pair<std::int64_t, std::int64_t>> window;
+  // Steady state: the window chosen from the twin's runs instead (steady_window.hpp): the
+  // longest ending at the experiment's last cycle over which every observable fitted has
+  // stopped changing within one packing's scatter.
+  bool auto_window = false;
   std::string noise = "auto";  // displacements: none, fit, auto, or a value in voxels
   bool per_cycle = false;      // displacements: each cycle's CDF instead of the window's
   double wall_distance = 0;    // m: grains closer to a container face are left out
@@ -59,6 +63,8 @@ struct CalibrateOptions {
   const std::atomic<bool>* stop = nullptr;
 
   bool joint() const { return !mu_r.empty(); }
+  // --window's text: FIRST:LAST, or auto (`option` names it in an error).
+  void set_window(const std::string& text, const std::string& option);
   // Checks the options against each other (Error naming the command line's option);
   // calibrate() also checks them against the experiment before any run.
   void validate() const;

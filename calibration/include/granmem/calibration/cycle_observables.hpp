@@ -98,6 +98,26 @@ struct SteadyState {
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
                          const StructureOptions& structure = {},
                          std::optional<double> grain_radius = {});
+
+// Cycles, inclusive; (0, 0): every cycle.
+using CycleRange = std::pair<std::int64_t, std::int64_t>;
+
+// The same observables cycle by cycle, of which steady_state() takes a window's means: to
+// look for where a run has become steady (steady_window.hpp).
+struct ObservableSeries {
+  struct Entry {
+    std::string name;
+    std::vector<std::int64_t> cycle;
+    std::vector<double> value;  // NaN where not measured
+    bool always = false;        // in the window's means even when the window has no value
+  };
+  std::vector<Entry> entries;
+};
+ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
+                                   const StructureOptions& structure = {},
+                                   std::optional<double> grain_radius = {},
+                                   CycleRange cycles = {0, 0});
+SteadyState window_means(const ObservableSeries& series, CycleRange window);
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at
 // full compression (N)"); the name itself for one it does not know.
 std::string steady_state_label(const std::string& name);

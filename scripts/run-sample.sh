@@ -53,5 +53,5 @@ interval=$(sed -n 's/^  "mu_s_ci95": \[\(.*\),\(.*\)\],$/\1 \2/p' "$summary" |
   xargs printf '%.3g-%.3g')
 echo "sliding friction: fitted $fitted (95% interval $interval), true $TRUE_MU_S" \
   | tee "$out/result.txt"
-echo "figures and tables in $out/calibration/ (pdf_displacement.png, calibration.png, ...)"
+echo "figures and tables in $out/calibration/ (observable_fit.png, pdf_displacement.png, ...)"
 step "done"

@@ -123,7 +123,9 @@ std::vector<fs::path> plot_log_pdfs(const fs::path& dir, const std::string& name
   o.range = std::make_pair(lo, hi);
   std::ostringstream data, plot;
   data.precision(8);
-  plot << "set title " << quoted(title) << "\nset logscale xy\nset format xy \"10^{%T}\"\n"
+  // The pdfs peak mid-axis and fall off to the right: the lower left is where the key is free.
+  plot << "set title " << quoted(title)
+       << "\nset key bottom left\nset logscale xy\nset format xy \"10^{%T}\"\n"
        << "set xlabel " << quoted(x_label) << "\nset ylabel \"probability density\"\nplot ";
   const char* marks[] = {"7", "6", "5", "4", "9", "8"};
   for (std::size_t k = 0; k < samples.size(); ++k) {

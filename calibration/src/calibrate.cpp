@@ -437,8 +437,8 @@ void write_steady_state_runs(const fs::path& out, const ObservableFit& fit,
 
 SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableFit& fit,
                                           const SteadyState& experiment,
-                                          const std::vector<SteadyStateRun>& runs,
-                                          double true_mu_s) {
+                                          const std::vector<SteadyStateRun>& runs, double true_mu_s,
+                                          CycleRange window) {
   SteadyStateOutputs o;
   write_steady_state_runs(out, fit, runs);
   o.written.push_back(out / "steady_state_runs.csv");
@@ -474,9 +474,10 @@ SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableF
         {"twin_drift_over_window", twin_drift}, {"model_at_fit", fit.model[k]},
         {"packing_scatter", fit.scatter[k]},    {"log_mu_s_resolution", fit.resolution[k]}};
   }
-  char title[160];
-  std::snprintf(title, sizeof title, "steady-state fit: mu_s = %.3g (95%% %.3g-%.3g)%s", fit.mu_s,
-                fit.mu_s_ci95[0], fit.mu_s_ci95[1],
+  char title[200];
+  std::snprintf(title, sizeof title, "means over cycles %lld-%lld: mu_s = %.3g (95%% %.3g-%.3g)%s",
+                static_cast<long long>(window.first), static_cast<long long>(window.second),
+                fit.mu_s, fit.mu_s_ci95[0], fit.mu_s_ci95[1],
                 std::isfinite(true_mu_s) ? (", true " + number_text(true_mu_s)).c_str() : "");
   const auto figure =
       plot_observable_fit(out, "observable_fit", panels, fit.mu_s, fit.mu_s_ci95, true_mu_s, title);
@@ -519,7 +520,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
   s.simulations = simulations_with(twin, specs, best);
   const SteadyStateOutputs written =
-      write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s);
+      write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s, twin.observe.window);
   s.written.insert(s.written.end(), written.written.begin(), written.written.end());
   JsonObject j;
   j["mu_s"] = fit.mu_s;

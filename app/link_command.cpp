@@ -22,6 +22,7 @@ LinkRunOptions link_run_options(const LinkArgs& args) {
   o.collective_motion = !args.no_drift;
   o.container = args.container;
   o.container_size = args.container_size;
+  o.first_cycle = args.first_cycle;
   return o;
 }
 
@@ -44,6 +45,11 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
                   "the container's edges LX,LY,LZ with a unit, its position found from the "
                   "packing's extent in the first scan (lowest x - r, y - r, z - r: grains "
                   "pressed into it touch its floor and walls); instead of --container");
+  cmd->add_option("--first-cycle", args.first_cycle,
+                  "the cycle at whose end the first scan was taken, where the scans do not say "
+                  "theirs: frames numbered from it in the order given (the last 10 of 500: "
+                  "491)")
+      ->capture_default_str();
   cmd->add_option("--report", args.report,
                   "CSV of what could not be linked: tracks lost and detections starting a track");
 }

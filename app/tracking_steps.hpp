@@ -31,6 +31,7 @@ Detections locate_scan(const std::string& path, const LocateArgs& args, std::int
 struct LinkArgs {
   std::string max_displacement = "auto", report, container, container_size;
   int memory = 2;
+  std::int64_t first_cycle = 0;
   bool no_drift = false;
 };
 void add_link_options(CLI::App* cmd, LinkArgs& args);

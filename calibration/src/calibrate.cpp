@@ -202,6 +202,8 @@ class Twin {
         names.push_back(name);
     SteadyWindowOptions options;
     options.last = observe.window.second;
+    // The experiment's first scan ends cycle steps.front(): its first whole cycle is the next.
+    options.earliest = std::max<std::int64_t>(1, experiment_.steps().front() + 1);
     const SteadyWindow w = choose_steady_window(runs, cell, names, options);
     observe.window = w.window;
     measured = measured_observables(experiment_, observe);

@@ -50,11 +50,12 @@ SteadyWindow choose_steady_window(const std::vector<ObservableSeries>& runs,
                                   const std::vector<std::string>& names,
                                   const SteadyWindowOptions& options) {
   if (runs.size() != cell.size()) throw Error("choose_steady_window: one cell per run");
-  if (options.last < 1 || options.min_cycles < 2) {
+  if (options.last < 1 || options.min_cycles < 2 || options.earliest < 1) {
     throw Error("choose_steady_window: needs a last cycle and windows of 2 cycles or more");
   }
   SteadyWindow chosen;
-  for (std::int64_t first = 1; first + options.min_cycles - 1 <= options.last; ++first) {
+  for (std::int64_t first = options.earliest; first + options.min_cycles - 1 <= options.last;
+       ++first) {
     std::vector<SteadyState> means;
     for (const ObservableSeries& run : runs)
       means.push_back(window_means(run, {first, options.last}));
@@ -75,8 +76,9 @@ SteadyWindow choose_steady_window(const std::vector<ObservableSeries>& runs,
       return chosen;
     }
   }
-  chosen.window = {std::max<std::int64_t>(1, options.last - options.fallback_cycles + 1),
-                   options.last};
+  chosen.window = {
+      std::max<std::int64_t>(options.earliest, options.last - options.fallback_cycles + 1),
+      options.last};
   return chosen;
 }
 

@@ -51,6 +51,10 @@ TEST(SteadyWindow, StartsWhereTheLastTransientHasEnded) {
   EXPECT_TRUE(w.unsteady.empty());
   // With the rotation left out, the packing's end alone sets it.
   EXPECT_EQ(choose_steady_window(runs, cell, {"packing"}, o).window, (CycleRange{5, 20}));
+  // An experiment scanned from cycle 11 on: no window starts before it.
+  o.earliest = 11;
+  EXPECT_EQ(choose_steady_window(runs, cell, {"packing", "rotation"}, o).window,
+            (CycleRange{11, 20}));
 }
 
 TEST(SteadyWindow, FallsBackToTheLastCyclesAndNamesWhatStillChanges) {

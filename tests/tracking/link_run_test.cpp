@@ -66,6 +66,28 @@ TEST(LinkRun, ScansThatAllSayOneFrameAreNumberedInOrder) {
   EXPECT_NE(r.Report().find("linked 2 scans: 3 tracks"), std::string::npos) << r.Report();
 }
 
+// The last scans of a long run: numbered from the cycle given, the store's steps those
+// cycles. Scans that say their own frames keep them, and are not renumbered.
+TEST(LinkRun, ScansAreNumberedFromTheFirstCycleGiven) {
+  LinkRunOptions o;
+  o.first_cycle = 491;
+  const LinkRun r = link_run(scans_of_three_grains(), {"s0", "s1"}, o);
+  ASSERT_EQ(r.run.frames.size(), 2u);
+  EXPECT_EQ(r.run.frames[0].step, 491);
+  EXPECT_EQ(r.run.frames[1].step, 492);
+  EXPECT_NE(r.notes[0].find("numbered 491..492"), std::string::npos) << r.notes[0];
+  const std::vector<Detections> numbered{scan(491, {a, b}), scan(492, {a, b})};
+  EXPECT_EQ(link_run(numbered, {"s0", "s1"}, o).run.frames[1].step, 492);
+  const std::vector<Detections> own{scan(0, {a, b}), scan(1, {a, b})};
+  expect_error(
+      [&] {
+        link_run(own, {"s0", "s1"}, o);
+      },
+      {"--first-cycle 491", "their own frames (0, 1, ...)"});
+  o.first_cycle = -1;
+  expect_error([&] { o.validate(); }, {"--first-cycle", "0 or more"});
+}
+
 TEST(LinkRun, WhatCouldNotBeLinkedIsInTheContainersFrame) {
   LinkRunOptions o;
   o.container = "1,2,3,51,52,53mm";

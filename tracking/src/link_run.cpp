@@ -21,16 +21,28 @@ std::string vector_text(const Eigen::Vector3d& v) {
   return s.str();
 }
 
-// Detections located one stack at a time all say frame 0: numbered as given.
-void number_frames(std::vector<Detections>& scans, std::vector<std::string>& notes) {
+// Detections located one stack at a time all say frame 0: numbered as given, from the
+// first cycle.
+void number_frames(std::vector<Detections>& scans, std::int64_t first,
+                   std::vector<std::string>& notes) {
   bool same_frame = true;
   for (const Detections& d : scans)
     same_frame = same_frame && d.frame == scans.front().frame;
-  if (!same_frame || scans.size() < 2) return;
-  notes.push_back("every scan says frame " + std::to_string(scans.front().frame) +
-                  ": numbered 0.." + std::to_string(scans.size() - 1) + " in the order given");
+  bool from_first = true;  // already numbered so (track numbers its scans as it locates them)
   for (std::size_t t = 0; t < scans.size(); ++t)
-    scans[t].frame = std::int64_t(t);
+    from_first = from_first && scans[t].frame == first + std::int64_t(t);
+  if (from_first) return;
+  if (!same_frame && first != 0) {
+    throw Error("--first-cycle " + std::to_string(first) + ": the scans say their own frames (" +
+                std::to_string(scans.front().frame) + ", " + std::to_string(scans[1].frame) +
+                ", ...); it numbers scans that do not");
+  }
+  if (!same_frame || (scans.size() < 2 && first == 0)) return;
+  notes.push_back("every scan says frame " + std::to_string(scans.front().frame) + ": numbered " +
+                  std::to_string(first) + ".." +
+                  std::to_string(first + std::int64_t(scans.size()) - 1) + " in the order given");
+  for (std::size_t t = 0; t < scans.size(); ++t)
+    scans[t].frame = first + std::int64_t(t);
 }
 
 void check_units(const std::vector<Detections>& scans, const std::vector<std::string>& names) {
@@ -79,6 +91,7 @@ void register_run(LinkRun& r, const LinkRunOptions& o, const std::string& unit) 
 
 void LinkRunOptions::validate() const {
   if (memory < 0) throw Error("--memory: 0 or more scans");
+  if (first_cycle < 0) throw Error("--first-cycle: a cycle, 0 or more");
   if (!container.empty() && !container_size.empty()) {
     throw Error("--container and --container-size: give the container or its size, not both");
   }
@@ -99,7 +112,7 @@ LinkRun link_run(std::vector<Detections> scans, const std::vector<std::string>& 
   if (scans.empty()) throw Error("link: no scans");
   if (names.size() != scans.size()) throw Error("link: a name per scan");
   LinkRun r;
-  number_frames(scans, r.notes);
+  number_frames(scans, options.first_cycle, r.notes);
   check_units(scans, names);
   const std::string unit = scans.front().length_unit;
   r.run = link_scans(scans, link_options(options, unit), &r.summary);

@@ -36,7 +36,7 @@ TrackSummary track_run(const TrackRunOptions& o) {
   std::vector<std::string> names;
   for (std::size_t k = 0; k < o.scans.size(); ++k) {
     ScanLocateOptions locate = o.locate;
-    locate.frame = std::int64_t(k);
+    locate.frame = o.link.first_cycle + std::int64_t(k);
     LocatedScan s = locate_scan(o.scans[k], locate);
     if (o.log) o.log(s.Report());
     if (!o.detections.empty()) {

@@ -13,6 +13,7 @@ namespace granmem {
 // themselves (calibrate --window auto) instead of assumed.
 struct SteadyWindowOptions {
   std::int64_t last = 0;        // the window's last cycle (the experiment's last)
+  std::int64_t earliest = 1;    // the first cycle a window may start at (the experiment's)
   std::int64_t min_cycles = 3;  // the shortest window looked at
   // Without a steady window: the last this many cycles, as the paper's 10 after 500.
   std::int64_t fallback_cycles = 10;

@@ -26,6 +26,9 @@ struct LinkRunOptions {
   // "LX,LY,LZ<unit>" (its position found from the packing's extent in the first scan):
   // positions are then stored in its frame and it is the run's box. Empty: neither.
   std::string container, container_size;
+  // The cycle at whose end the first scan was taken, when the scans do not say theirs: the
+  // scans are then frames first_cycle, first_cycle + 1, ... (e.g. the last 10 of 500).
+  std::int64_t first_cycle = 0;
   // A line per scan as it is linked, and a flag that stops between two (LinkOptions).
   std::function<void(const std::string&)> log;
   const std::atomic<bool>* stop = nullptr;

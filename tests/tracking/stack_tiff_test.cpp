@@ -263,6 +263,21 @@ TEST_F(TiffStackTest, HyperstacksOfSeveralChannelsAreRefused) {
   expect_read_error(path("hyper.tif"), {"2 channels", "expected one channel"});
 }
 
+// Counts beyond any stack (found by fuzz_tiff: 2e30 slices overflowed the integer they were
+// cast to) are one clear error, in ImageJ's description and in OME's XML alike.
+TEST_F(TiffStackTest, CountsBeyondAnyStackAreRefused) {
+  TiffLayout imagej;
+  imagej.description = "ImageJ=0.11a\nslices=2" + std::string(30, '2') + "\n";
+  write_libtiff(path("imagej.tif"), pattern_stack(16, 16, 4, 8), imagej);
+  expect_read_error(path("imagej.tif"), {"imagej.tif", "ImageJ metadata", "slices=", "beyond"});
+  TiffLayout ome;
+  ome.description =
+      "<?xml version='1.0'?><OME><Image><Pixels SizeZ='1e300' PhysicalSizeX='0.05'/>"
+      "</Image></OME>";
+  write_libtiff(path("ome.tif"), pattern_stack(16, 16, 4, 8), ome);
+  expect_read_error(path("ome.tif"), {"ome.tif", "OME metadata", "SizeZ=1e300", "beyond"});
+}
+
 // ---- Bad input: one line naming the file, nothing written ------------------------------
 
 TEST_F(TiffStackTest, TruncatedFilesAreReportedNotMisread) {

@@ -57,11 +57,19 @@ std::map<std::string, std::string> imagej_fields(std::string_view description) {
   return fields;
 }
 
-std::int64_t count_field(const std::map<std::string, std::string>& fields, const char* key) {
+// A count the metadata declare (channels, slices, frames, images); 0 where they say none.
+// One beyond any stack (2e30 slices) is refused here: it would not fit an integer. `where`:
+// the file and the metadata's kind, for the message.
+std::int64_t count_field(const std::map<std::string, std::string>& fields, const char* key,
+                         const std::string& where) {
   const auto it = fields.find(key);
   if (it == fields.end()) return 0;
   const auto value = parse_number(it->second);
-  return value && *value >= 0 ? static_cast<std::int64_t>(*value) : 0;
+  if (!value || !(*value >= 0)) return 0;
+  if (*value > 1e15) {
+    throw Error(where + " declares " + key + "=" + it->second + ", beyond any stack");
+  }
+  return static_cast<std::int64_t>(*value);
 }
 
 // One scan is one channel and, if it is a z stack, one time frame.
@@ -80,10 +88,11 @@ void check_single_scan(const TiffFile& file, const char* format, std::int64_t ch
 
 TiffMetadata imagej_metadata(const TiffFile& file, std::string_view description) {
   const auto fields = imagej_fields(description);
-  check_single_scan(file, "ImageJ", count_field(fields, "channels"), count_field(fields, "slices"),
-                    count_field(fields, "frames"));
+  const std::string where = file.name() + ": ImageJ metadata";
+  check_single_scan(file, "ImageJ", count_field(fields, "channels", where),
+                    count_field(fields, "slices", where), count_field(fields, "frames", where));
   TiffMetadata meta;
-  meta.imagej_images = count_field(fields, "images");
+  meta.imagej_images = count_field(fields, "images", where);
 
   // ImageJ's unit: the description's, else the TIFF resolution unit (inch or cm).
   std::optional<LengthUnit> unit;
@@ -205,12 +214,9 @@ std::map<std::string, std::string> ome_pixels_attributes(std::string_view xml) {
 
 TiffMetadata ome_metadata(const TiffFile& file, std::string_view xml) {
   const auto pixels = ome_pixels_attributes(xml);
-  const auto count = [&](const char* key) -> std::int64_t {
-    const auto it = pixels.find(key);
-    const auto value = it == pixels.end() ? std::nullopt : parse_number(it->second);
-    return value ? static_cast<std::int64_t>(*value) : 0;
-  };
-  check_single_scan(file, "OME", count("SizeC"), count("SizeZ"), count("SizeT"));
+  const std::string where = file.name() + ": OME metadata";
+  check_single_scan(file, "OME", count_field(pixels, "SizeC", where),
+                    count_field(pixels, "SizeZ", where), count_field(pixels, "SizeT", where));
 
   // Each axis has its own unit, micrometres when not given (the OME schema's default);
   // all three are needed, in the unit of x.

@@ -317,7 +317,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
     folder ``out`` (finished runs are reused when called again), and the friction fitted
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
-    (``(first, last)`` cycles; default its last 10): "displacements" (the end-of-cycle
+    (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
+    window ending there over which the twin's runs are steady): "displacements" (the end-of-cycle
     displacement distribution) or "steady-state" (window means of rotation, packing
     fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
     identify friction.

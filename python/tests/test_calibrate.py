@@ -39,6 +39,15 @@ def test_calibrate_in_python_equals_the_command_line(tmp_path, cli, experiment):
     assert ours["settings"] == theirs["settings"]
 
 
+def test_the_window_chosen_from_the_runs_is_the_command_lines(tmp_path, cli, experiment):
+    auto = dict(FIT, window="auto")
+    fit = granmem.calibrate(experiment, tmp_path / "py", **auto, **TWIN)
+    assert "window from the twin's runs: cycles " in fit["report"]
+    out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.05,0.1,0.2,0.4",
+              "--window", "auto", "--observables", "steady-state", "--fit-only", *TWIN_FLAGS)
+    assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
+
+
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):
     def stop_at_first_report(report):
         if "cycle" in report:

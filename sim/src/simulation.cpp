@@ -110,6 +110,7 @@ void Simulation::set_threads(int threads) {
                  ? threads
                  : std::clamp(int(grains_.size() / kGrainsPerThread), 1, omp_get_max_threads());
   neighbors_.set_threads(threads_);
+  wall_touchers_.assign(std::size_t(threads_), {});
 }
 
 void Simulation::rebuild_neighbors() {
@@ -358,6 +359,7 @@ GRANMEM_INLINE void Simulation::finish_grain(std::size_t i, const PendingGrain& 
     t += pair_force_[k].torque_on_i;
   }
   add_walls(i, pass.planes, pass.commit, f, t);
+  if (wall_touch_[i]) pass.wall_touchers->push_back(p.rank);
   if (!pass.commit) return;
   half_kick(i, f, t);  // the step's second half kick, while the grain is at hand
   if (!pass.drift) return;
@@ -391,11 +393,15 @@ GRANMEM_INLINE bool Simulation::drift(std::size_t i) {
 // share's own (their owners' ids are smaller than any in the share).
 bool Simulation::compute_forces(bool commit, bool drift) {
   bool moved_too_far = false;
+  for (auto& touchers : wall_touchers_)
+    touchers.clear();
 #pragma omp parallel num_threads(threads_) reduction(|| : moved_too_far)
   {
     const int threads = omp_get_num_threads();
-    const Share s = share(omp_get_thread_num(), threads);
+    const int thread = omp_get_thread_num();
+    const Share s = share(thread, threads);
     Pass p = pass(commit, drift);
+    p.wall_touchers = &wall_touchers_[std::size_t(thread)];
     PairLanes lanes;
     start_sums(s);
     if (threads > 1) {
@@ -412,14 +418,17 @@ bool Simulation::compute_forces(bool commit, bool drift) {
 
 void Simulation::sum_wall_loads() {
   const int walls = container_.lid.present ? kWallCount : kWallCount - 1;
-  // Loads on the walls, summed in the order of grain ids (the lid's motion depends on them).
+  // Loads on the walls, summed in the order of grain ids (the lid's motion depends on them):
+  // the shares' lists of grains at a wall, in share order.
   wall_loads_ = WallLoads{};
-  for (std::size_t i : by_id_) {
-    if (!wall_touch_[i]) continue;
-    for (int w = 0; w < walls; ++w) {
-      if (wall_touch_[i] & (1u << w)) {
-        wall_loads_.force[w] += wall_force_on_grain_[i][w];
-        ++wall_loads_.contacts[w];
+  for (const auto& touchers : wall_touchers_) {
+    for (std::uint32_t r : touchers) {
+      const std::size_t i = by_id_[r];
+      for (int w = 0; w < walls; ++w) {
+        if (wall_touch_[i] & (1u << w)) {
+          wall_loads_.force[w] += wall_force_on_grain_[i][w];
+          ++wall_loads_.contacts[w];
+        }
       }
     }
   }

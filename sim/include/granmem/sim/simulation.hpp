@@ -153,6 +153,7 @@ class Simulation {
     bool commit, drift;
     Planes planes;
     bool moved_too_far = false;
+    std::vector<std::uint32_t>* wall_touchers = nullptr;  // the share's, in id order
   };
   Pass pass(bool commit, bool drift) const;
   void finish_sums(Share s, Pass& pass, PairLanes& lanes);
@@ -202,7 +203,10 @@ class Simulation {
   std::vector<PairForce> pair_force_;   // of the pairs whose grains are in two shares
   std::vector<std::array<ContactHistory, kWallCount>> wall_history_;
   std::vector<std::array<Eigen::Vector3d, kWallCount>> wall_force_on_grain_;
-  std::vector<std::uint8_t> wall_touch_;       // bit w: grain touches wall w
+  std::vector<std::uint8_t> wall_touch_;  // bit w: grain touches wall w
+  // Per share (thread), the ranks of its grains that touch a wall at the last force
+  // evaluation, in id order: the wall loads are summed over these alone.
+  std::vector<std::vector<std::uint32_t>> wall_touchers_;
   std::vector<std::uint8_t> wall_remembered_;  // bit w: a committed history against wall w
   WallLoads wall_loads_;
   std::vector<std::size_t> by_id_;   // grain indices in increasing id

@@ -29,7 +29,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                  observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
-    int threads = 0, degree = 2, replicas = 2;
+    int threads = 0, degree = 2, replicas = 2, refine = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -62,6 +62,12 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "realization noise the interval includes")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--refine", args->refine,
+                  "steady-state, --fit mu_s: packings added at the fit of the --mu-s x "
+                  "--replicas design, each its own seed, and the fit made again on every run "
+                  "(they measure one packing's scatter where the experiment is)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "
                   "(as the experiment was prepared); shared: one packing per seed deposited at "
@@ -133,6 +139,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.subtract_drift = args->subtract_drift;
     o.degree = args->degree;
     o.replicas = args->replicas;
+    o.refine = args->refine;
     o.preparation = args->preparation == "shared" ? TwinPreparation::shared : TwinPreparation::each;
     o.fit_only = args->fit_only;
     o.parallel = args->threads;

@@ -8,6 +8,7 @@
 #   scripts/steady_state_calibration.sh [--out DIR] [--granmem BIN] [--mu-s LIST]
 #                                       [--replicas N] [--joint] [--grains N]
 #                                       [--cycles C] [--window F:L] [--pseudo LIST]
+#                                       [--refine N] [--only LIST]
 #
 # --grains, --cycles and --window change the protocol (default 1500, 40, 31:40); --pseudo
 # the pseudo-experiments, as "mu_s:seed,mu_s:seed,..." (default 0.15:7,0.25:8,0.35:9,0.1:10).
@@ -17,6 +18,9 @@
 # runs, in DIR/runs, reused by every fit and by a second call (stopped runs are redone).
 # --joint: also the joint mu_s / mu_r fit of the first pseudo-experiment (mu_r = 0.01) on
 # a 3 x 3 grid (mu_s 0.05,0.12,0.3 x mu_r 0.004,0.012,0.036) x 2 packings, in DIR/joint.
+# --refine N: the two-stage twin, N packings of new seeds added at the --mu-s x --replicas
+# design's fit (`calibrate --refine`); its fits in DIR/fit_refineN_<pseudo>, DIR/fits_refineN.csv.
+# --only: the observables fitted (default all the pseudo-experiment has).
 # Writes DIR/fits.csv (one line per pseudo-experiment) and each fit's folder.
 set -euo pipefail
 
@@ -30,6 +34,8 @@ grains=1500
 cycles=40
 window=31:40
 pseudos="0.15:7,0.25:8,0.35:9,0.1:10"
+refine=0
+only=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --out) out="$2"; shift ;;
@@ -41,11 +47,14 @@ while [[ $# -gt 0 ]]; do
     --cycles) cycles="$2"; shift ;;
     --window) window="$2"; shift ;;
     --pseudo) pseudos="$2"; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    --refine) refine="$2"; shift ;;
+    --only) only=(--only "$2"); shift ;;
+    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
     *) echo "steady_state_calibration.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
 done
+granmem=$(realpath "$granmem")
 [[ -x $granmem ]] || { echo "steady_state_calibration.sh: no granmem at $granmem" >&2; exit 1; }
 mkdir -p "$out/runs"
 cd "$out"
@@ -67,8 +76,7 @@ pseudo() {  # name mu_s seed: simulated once, resumed from its checkpoint if sto
               --checkpoint "$name.checkpoint.h5")
   [[ -s $name.checkpoint.h5 ]] && args=(--resume "$name.checkpoint.h5")
   OMP_NUM_THREADS=1 "$granmem" --config protocol.toml simulate --threads 1 "${args[@]}" \
-    > "$name.log" 2>&1
-  touch "$name.done"
+    > "$name.log" 2>&1 && touch "$name.done"
 }
 export -f pseudo
 export granmem
@@ -77,21 +85,24 @@ for p in ${pseudos//,/ }; do names+=("pseudo_${p%%:*}_seed_${p##*:}"); done
 for p in ${pseudos//,/ }; do echo "pseudo_${p%%:*}_seed_${p##*:} ${p%%:*} ${p##*:}"; done |
   xargs -P 2 -L 1 bash -c 'pseudo "$@"' _
 
-echo "experiment,mu_s_true,mu_s,ci95_low,ci95_high,n_simulations" > fits.csv.tmp
+tag=""
+[[ $refine -gt 0 ]] && tag="_refine$refine"
+echo "experiment,mu_s_true,mu_s,ci95_low,ci95_high,n_simulations" > "fits$tag.csv.tmp"
 for p in "${names[@]}"; do
-  mkdir -p "fit_$p"
-  ln -sfn ../runs "fit_$p/runs"
-  "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "fit_$p" \
-    --mu-s "$mus" --replicas "$replicas" --observables steady-state --fit-only --threads 2 \
-    2> "fit_$p.log" | tee "fit_$p.txt"
+  fit="fit${tag}_$p"
+  mkdir -p "$fit"
+  ln -sfn ../runs "$fit/runs"
+  "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "$fit" \
+    --mu-s "$mus" --replicas "$replicas" --refine "$refine" "${only[@]}" \
+    --observables steady-state --fit-only --threads 2 2> "$fit.log" | tee "$fit.txt"
   awk -v p="$p" '/"mu_s":/ {gsub(/[,]/, ""); m = $2}
     /"mu_s_ci95":/ {gsub(/[][,]/, " "); lo = $2; hi = $3}
     /"mu_s_true":/ {gsub(/,/, ""); t = $2}
     /"n_simulations":/ {gsub(/,/, ""); n = $2}
-    END {print p "," t "," m "," lo "," hi "," n}' "fit_$p/summary.json" >> fits.csv.tmp
+    END {print p "," t "," m "," lo "," hi "," n}' "$fit/summary.json" >> "fits$tag.csv.tmp"
 done
-mv fits.csv.tmp fits.csv
-cat fits.csv
+mv "fits$tag.csv.tmp" "fits$tag.csv"
+cat "fits$tag.csv"
 
 if [[ $joint -eq 1 ]]; then
   "$granmem" --config protocol.toml calibrate --experiment "${names[0]}.h5" --out joint \

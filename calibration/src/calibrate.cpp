@@ -233,6 +233,8 @@ class Twin {
 
   const CalibrateOptions& options() const { return o_; }
   const TrajectoryReader& experiment() const { return experiment_; }
+  // The seeds after the design's: packings none of its runs pour.
+  std::uint64_t next_seed(int k) const { return seeds_.back() + 1 + std::uint64_t(k); }
   const RunSettings& settings() const { return settings_; }
   std::uint64_t seed() const { return deposit_.seed; }
 
@@ -506,14 +508,45 @@ void add_comparison(CalibrateSummary& s, std::ostream& report, const Comparison&
   report << c.Report();
 }
 
+ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs) {
+  ObservableFitOptions fo;
+  fo.degree = twin.options().degree;
+  return fit_friction_to_steady_state(twin.measured_steady_state(), runs, fo, twin.options().only);
+}
+
+// --refine: the design fitted, then packings more at its fit, each a new seed. Within the
+// design's range only: a fit at its edge says the range is wrong, not where to look.
+std::vector<FrictionRunSpec> refined_design(const Twin& twin, std::vector<FrictionRunSpec> specs,
+                                            std::ostream& report) {
+  const CalibrateOptions& o = twin.options();
+  const ObservableFit first = steady_state_fit(twin, twin_steady_states(twin, specs));
+  const double mu = three_digits(first.mu_s);
+  const auto [lo, hi] = std::minmax_element(o.mu_s.begin(), o.mu_s.end());
+  std::ostringstream line;
+  line << std::setprecision(3) << "the design's fit: mu_s = " << first.mu_s << " (95% interval "
+       << first.mu_s_ci95[0] << " - " << first.mu_s_ci95[1] << ", " << specs.size() << " runs); ";
+  if (!(mu > *lo && mu < *hi)) {
+    line << "not refined: the fit is at the edge of the frictions simulated (widen --mu-s)";
+  } else {
+    line << o.refine << " packing(s) more at mu_s " << number_text(mu) << ", seeds "
+         << twin.next_seed(0) << "-" << twin.next_seed(o.refine - 1);
+    std::vector<FrictionRunSpec> more;
+    for (int k = 0; k < o.refine; ++k)
+      more.push_back({mu, twin.next_seed(k)});
+    twin.say(line.str());
+    twin.run(more);
+    specs.insert(specs.end(), more.begin(), more.end());
+  }
+  report << line.str() << "\n";
+  return specs;
+}
+
 void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                       CalibrateSummary& s, std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
-  ObservableFitOptions fo;
-  fo.degree = o.degree;
   const SteadyState measured = twin.measured_steady_state();
-  const ObservableFit fit = fit_friction_to_steady_state(measured, runs, fo, o.only);
+  const ObservableFit fit = steady_state_fit(twin, runs);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed()};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
@@ -536,6 +569,13 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["dof"] = fit.dof;
   j["n_simulations"] = s.simulations;
   j["replicas"] = o.replicas;
+  std::vector<double> simulated;
+  for (const FrictionRunSpec& spec : specs)
+    simulated.push_back(spec.mu_s);
+  std::sort(simulated.begin(), simulated.end());
+  simulated.erase(std::unique(simulated.begin(), simulated.end()), simulated.end());
+  j["mu_s_simulated"] = simulated;
+  j["refine"] = o.refine;
   j["observables"] = written.observables;
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
@@ -788,6 +828,12 @@ void CalibrateOptions::validate() const {
         "--window auto: only with --observables steady-state (a steady window is "
         "where its observables stop changing)");
   }
+  if (refine < 0) throw Error("--refine: a number of packings, 0 or more");
+  if (refine > 0 && (!steady || joint())) {
+    throw Error(
+        "--refine: only with --observables steady-state and --fit mu_s (packings added at "
+        "the fitted mu_s)");
+  }
   if (auto_window && replicas < 2) {
     throw Error(
         "--window auto: needs --replicas 2 or more (one packing's scatter is what a "
@@ -816,10 +862,11 @@ CalibrateSummary calibrate(const CalibrateOptions& options) {
   fs::create_directories(options.out / "runs");
   twin.announce();
   twin.prepare_shared_packings();
-  const std::vector<FrictionRunSpec> specs = twin.design();
+  std::vector<FrictionRunSpec> specs = twin.design();
   twin.run(specs);
   std::ostringstream report;
   if (options.auto_window) report << twin.choose_window(specs) << "\n";
+  if (options.refine > 0) specs = refined_design(twin, std::move(specs), report);
   if (options.joint()) {
     fit_joint(twin, specs, s, report);
   } else if (steady) {

@@ -311,7 +311,7 @@ def _frictions(value):
 def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=2,
-              deposit="each", fit_only=False, parallel=0, progress=None, **twin):
+              refine=0, deposit="each", fit_only=False, parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -321,7 +321,9 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     window ending there over which the twin's runs are steady): "displacements" (the end-of-cycle
     displacement distribution) or "steady-state" (window means of rotation, packing
     fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
-    identify friction.
+    identify friction. ``refine`` (steady-state, mu_s alone): that many packings more, each
+    its own seed, at the fit of the ``mu_s`` x ``replicas`` design, and the fit made again on
+    every run.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``
@@ -333,5 +335,6 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
-                              int(degree), int(replicas), deposit, bool(fit_only),
+                              int(degree), int(replicas), int(refine), deposit,
+                              bool(fit_only),
                               int(parallel), twin, progress)

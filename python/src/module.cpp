@@ -740,8 +740,8 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       const std::string& observables, const std::vector<std::string>& only,
                       const std::optional<std::string>& window, const std::string& noise,
                       const std::string& summaries, const std::string& wall_distance,
-                      bool subtract_drift, int degree, int replicas, const std::string& deposit,
-                      bool fit_only, int parallel, const py::dict& twin,
+                      bool subtract_drift, int degree, int replicas, int refine,
+                      const std::string& deposit, bool fit_only, int parallel, const py::dict& twin,
                       const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
@@ -766,6 +766,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.subtract_drift = subtract_drift;
   o.degree = degree;
   o.replicas = replicas;
+  o.refine = refine;
   if (deposit != "each" && deposit != "shared") {
     throw Error("deposit '" + deposit + "': expected each or shared");
   }
@@ -898,7 +899,8 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("only") = std::vector<std::string>{}, py::arg("window") = py::none(),
         py::arg("noise") = "auto", py::arg("summaries") = "pooled", py::arg("wall_distance") = "0",
         py::arg("subtract_drift") = true, py::arg("degree") = CalibrateOptions{}.degree,
-        py::arg("replicas") = CalibrateOptions{}.replicas, py::arg("deposit") = "each",
+        py::arg("replicas") = CalibrateOptions{}.replicas,
+        py::arg("refine") = CalibrateOptions{}.refine, py::arg("deposit") = "each",
         py::arg("fit_only") = false, py::arg("parallel") = 0, py::arg("twin") = py::dict(),
         py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),

@@ -48,6 +48,16 @@ def test_the_window_chosen_from_the_runs_is_the_command_lines(tmp_path, cli, exp
     assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
 
 
+def test_a_refined_design_is_the_command_lines(tmp_path, cli, experiment):
+    fit = granmem.calibrate(experiment, tmp_path / "py", **dict(FIT, refine=2), **TWIN)
+    assert fit["simulations"] == 10  # 4 frictions x 2 packings, and 2 packings at their fit
+    assert "packing(s) more at mu_s " in fit["report"]
+    out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.05,0.1,0.2,0.4",
+              "--window", "2:3", "--observables", "steady-state", "--fit-only", "--refine", "2",
+              *TWIN_FLAGS)
+    assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
+
+
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):
     def stop_at_first_report(report):
         if "cycle" in report:

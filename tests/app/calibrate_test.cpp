@@ -137,6 +137,38 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
                        {"--only", "lid_angle", "not measured", "exp.h5"});
 }
 
+// --refine: the design's fit, then packings of new seeds at it, and the fit again on all
+// runs, their held-out runs at the refined friction counted in the cross-validation.
+TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
+  expect_clean_failure(calibrate({"--refine", "2", "--mu-s", "0.05,0.1,0.4"}),
+                       {"--refine", "steady-state"});
+  const std::vector<std::string> design{
+      "--window", "2:3", "--mu-s", "0.05,0.1,0.4", "--observables", "steady-state", "--fit-only"};
+  const RunResult first = granmem_ok(calibrate(design));
+  std::vector<std::string> refined = design;
+  refined.insert(refined.end(), {"--refine", "2"});
+  const RunResult r = granmem_ok(calibrate(refined));
+  EXPECT_NE(r.err.find("reusing 6 finished runs"), std::string::npos) << r.err;
+  const std::string json = read_text(in_work("cal/summary.json"));
+  expect_fit_in_its_interval(json);
+  // The design's fit is the fit of the call without --refine, to the digits printed.
+  const std::string design_fit = first.out.substr(first.out.find("mu_s = ") + 7, 5);
+  EXPECT_NE(r.out.find("the design's fit: mu_s = " + design_fit), std::string::npos)
+      << first.out << r.out;
+  const std::size_t from = r.out.find("packing(s) more at mu_s ") + 24;
+  const std::string at = r.out.substr(from, r.out.find(", seeds", from) - from);
+  EXPECT_NEAR(std::stod(at), std::stod(design_fit), 0.0051);
+  EXPECT_NE(r.out.find("seeds 3-4"), std::string::npos) << r.out;
+  EXPECT_NE(json.find("\"n_simulations\": 8"), std::string::npos) << json;
+  for (const char* seed : {"_seed_3.h5", "_seed_4.h5"}) {
+    const std::string run = "cal/runs/mu_s_" + at + seed;
+    EXPECT_TRUE(std::filesystem::exists(in_work(run))) << run;
+  }
+  // Both new packings are interior runs of the cross-validation, beside the design's two
+  // at 0.1.
+  EXPECT_NE(r.out.find("on 4 runs"), std::string::npos) << r.out;
+}
+
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {
   expect_clean_failure(calibrate({"--fit", "mu_s,mu_r", "--mu-s", "0.05,0.2,0.4"}),
                        {"--fit mu_s,mu_r", "steady-state"});

@@ -63,7 +63,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--refine", args->refine,
-                  "steady-state, --fit mu_s: packings added at the fit of the --mu-s x "
+                  "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
                   "--replicas design, each its own seed, and the fit made again on every run "
                   "(they measure one packing's scatter where the experiment is)")
       ->capture_default_str()

@@ -514,30 +514,58 @@ ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRu
   return fit_friction_to_steady_state(twin.measured_steady_state(), runs, fo, twin.options().only);
 }
 
+// Strictly inside the range of `simulated`.
+bool interior(double mu, const std::vector<double>& simulated) {
+  const auto [lo, hi] = std::minmax_element(simulated.begin(), simulated.end());
+  return mu > *lo && mu < *hi;
+}
+
+// The design's fit, as the friction (pair) refined packings are added at, and its line.
+std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
+                                                   const std::vector<SteadyStateRun>& runs) {
+  const CalibrateOptions& o = twin.options();
+  std::ostringstream line;
+  line << std::setprecision(3) << "the design's fit: ";
+  FrictionRunSpec at;
+  if (o.joint()) {
+    ObservableFitOptions fo;
+    fo.degree = o.degree;
+    const JointObservableFit f =
+        fit_frictions_to_steady_state(twin.measured_steady_state(), runs, fo, o.only);
+    at = {three_digits(f.mu_s), 0, three_digits(f.mu_r)};
+    line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
+         << "), mu_r = " << f.mu_r << " (" << f.mu_r_ci95[0] << " - " << f.mu_r_ci95[1] << ")";
+  } else {
+    const ObservableFit f = steady_state_fit(twin, runs);
+    at = {three_digits(f.mu_s), 0};
+    line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
+         << ")";
+  }
+  line << ", " << runs.size() << " runs; ";
+  return {at, line.str()};
+}
+
 // --refine: the design fitted, then packings more at its fit, each a new seed. Within the
 // design's range only: a fit at its edge says the range is wrong, not where to look.
 std::vector<FrictionRunSpec> refined_design(const Twin& twin, std::vector<FrictionRunSpec> specs,
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  const ObservableFit first = steady_state_fit(twin, twin_steady_states(twin, specs));
-  const double mu = three_digits(first.mu_s);
-  const auto [lo, hi] = std::minmax_element(o.mu_s.begin(), o.mu_s.end());
-  std::ostringstream line;
-  line << std::setprecision(3) << "the design's fit: mu_s = " << first.mu_s << " (95% interval "
-       << first.mu_s_ci95[0] << " - " << first.mu_s_ci95[1] << ", " << specs.size() << " runs); ";
-  if (!(mu > *lo && mu < *hi)) {
-    line << "not refined: the fit is at the edge of the frictions simulated (widen --mu-s)";
+  auto [at, line] = design_fit(twin, twin_steady_states(twin, specs));
+  if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
+    line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";
+    twin.say(line);
   } else {
-    line << o.refine << " packing(s) more at mu_s " << number_text(mu) << ", seeds "
-         << twin.next_seed(0) << "-" << twin.next_seed(o.refine - 1);
+    line += std::to_string(o.refine) + " packing(s) more at mu_s " + number_text(at.mu_s) +
+            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") + ", seeds " +
+            std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(o.refine - 1));
+    twin.say(line);
     std::vector<FrictionRunSpec> more;
     for (int k = 0; k < o.refine; ++k)
-      more.push_back({mu, twin.next_seed(k)});
-    twin.say(line.str());
+      more.push_back({at.mu_s, twin.next_seed(k), at.mu_r});
     twin.run(more);
     specs.insert(specs.end(), more.begin(), more.end());
   }
-  report << line.str() << "\n";
+  report << line << "\n";
   return specs;
 }
 
@@ -829,10 +857,8 @@ void CalibrateOptions::validate() const {
         "where its observables stop changing)");
   }
   if (refine < 0) throw Error("--refine: a number of packings, 0 or more");
-  if (refine > 0 && (!steady || joint())) {
-    throw Error(
-        "--refine: only with --observables steady-state and --fit mu_s (packings added at "
-        "the fitted mu_s)");
+  if (refine > 0 && !steady) {
+    throw Error("--refine: only with --observables steady-state (packings added at the fit)");
   }
   if (auto_window && replicas < 2) {
     throw Error(

@@ -321,8 +321,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     window ending there over which the twin's runs are steady): "displacements" (the end-of-cycle
     displacement distribution) or "steady-state" (window means of rotation, packing
     fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
-    identify friction. ``refine`` (steady-state, mu_s alone): that many packings more, each
-    its own seed, at the fit of the ``mu_s`` x ``replicas`` design, and the fit made again on
+    identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
+    at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
     every run.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,

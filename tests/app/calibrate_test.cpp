@@ -193,6 +193,20 @@ TEST_F(Calibrate, FitsMuSAndMuRJointly) {
   EXPECT_DOUBLE_EQ(json_value(json, "mu_r_true"), 0.01);
   EXPECT_TRUE(std::filesystem::exists(in_work("cal/joint_fit.png")));
   EXPECT_TRUE(std::filesystem::exists(in_work("cal/runs/mu_s_0.2_mu_r_0.005_seed_1.h5")));
+  // --refine on this design: its mu_r is the lowest simulated, at the range's edge, so no
+  // packing is added there; on a wider range of mu_r two are, at the joint fit.
+  auto refine_joint = [&](const std::string& mu_r) {
+    return granmem_ok(calibrate({"--window", "2:3", "--mu-s", "0.05,0.2,0.4", "--mu-r", mu_r,
+                                 "--fit", "mu_s,mu_r", "--observables", "steady-state",
+                                 "--replicas", "1", "--fit-only", "--refine", "2"}));
+  };
+  const RunResult edge = refine_joint("0.005,0.01,0.02");
+  EXPECT_NE(edge.out.find("not refined: the fit is at the edge"), std::string::npos) << edge.out;
+  EXPECT_NE(edge.out.find("9 simulations"), std::string::npos) << edge.out;
+  const RunResult refined = refine_joint("0.002,0.01,0.03");
+  EXPECT_NE(refined.out.find("2 packing(s) more at mu_s "), std::string::npos) << refined.out;
+  EXPECT_NE(refined.out.find(", seeds 2-3"), std::string::npos) << refined.out;
+  EXPECT_NE(refined.out.find("11 simulations"), std::string::npos) << refined.out;
 }
 
 TEST_F(Calibrate, CompareTwoRuns) {

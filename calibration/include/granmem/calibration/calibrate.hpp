@@ -52,9 +52,9 @@ struct CalibrateOptions {
   int replicas = 2;            // packings per friction (seeds seed, seed + 1, ...)
   TwinPreparation preparation = TwinPreparation::each;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
-  // Steady state, mu_s alone: packings added at the design's fit, each its own seed (seed +
-  // replicas, ...), then the fit made again on every run. They measure one packing's
-  // scatter where the experiment is, as realizations independent of the design's.
+  // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
+  // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
+  // packing's scatter where the experiment is, as realizations independent of the design's.
   int refine = 0;
   int parallel = 0;  // runs at once, one thread each; 0: all cores
   // Lines saying what the calibration does (the twin, reused runs and packings), the

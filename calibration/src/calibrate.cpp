@@ -264,11 +264,12 @@ class Twin {
     say(line.str());
   }
 
-  // Shared packings: one per seed, kept in the output folder so that a second call
-  // reuses them.
-  void prepare_shared_packings() {
+  // Shared packings: one per seed (the design's, or `more`), kept in the output folder so
+  // that a second call reuses them.
+  void prepare_shared_packings(const std::vector<std::uint64_t>& more = {}) {
     if (o_.preparation != TwinPreparation::shared) return;
-    for (std::uint64_t seed : seeds_) {
+    for (std::uint64_t seed : more.empty() ? seeds_ : more) {
+      if (shared_.count(seed)) continue;
       const fs::path path = o_.out / ("packing_seed_" + std::to_string(seed) + ".checkpoint.h5");
       RunSettings settings = settings_;
       settings["seed"] = std::to_string(seed);
@@ -547,7 +548,7 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
 
 // --refine: the design fitted, then packings more at its fit, each a new seed. Within the
 // design's range only: a fit at its edge says the range is wrong, not where to look.
-std::vector<FrictionRunSpec> refined_design(const Twin& twin, std::vector<FrictionRunSpec> specs,
+std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunSpec> specs,
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   auto [at, line] = design_fit(twin, twin_steady_states(twin, specs));
@@ -560,8 +561,12 @@ std::vector<FrictionRunSpec> refined_design(const Twin& twin, std::vector<Fricti
             std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(o.refine - 1));
     twin.say(line);
     std::vector<FrictionRunSpec> more;
-    for (int k = 0; k < o.refine; ++k)
+    std::vector<std::uint64_t> seeds;
+    for (int k = 0; k < o.refine; ++k) {
       more.push_back({at.mu_s, twin.next_seed(k), at.mu_r});
+      seeds.push_back(twin.next_seed(k));
+    }
+    twin.prepare_shared_packings(seeds);
     twin.run(more);
     specs.insert(specs.end(), more.begin(), more.end());
   }

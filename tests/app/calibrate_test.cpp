@@ -167,6 +167,14 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
   // Both new packings are interior runs of the cross-validation, beside the design's two
   // at 0.1.
   EXPECT_NE(r.out.find("on 4 runs"), std::string::npos) << r.out;
+  // Packings deposited once per seed (--deposit shared): the added seeds get theirs.
+  std::vector<std::string> shared{"calibrate", "--experiment", "exp.h5", "--out",
+                                  "shared",    "--deposit",    "shared"};
+  shared.insert(shared.end(), kTwin.begin(), kTwin.end());
+  shared.insert(shared.end(), refined.begin(), refined.end());
+  const RunResult from_shared = granmem_ok(shared);
+  EXPECT_NE(from_shared.out.find("8 simulations"), std::string::npos) << from_shared.out;
+  EXPECT_TRUE(std::filesystem::exists(in_work("shared/packing_seed_4.checkpoint.h5")));
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {

@@ -278,6 +278,21 @@ TEST_F(TiffStackTest, CountsBeyondAnyStackAreRefused) {
   expect_read_error(path("ome.tif"), {"ome.tif", "OME metadata", "SizeZ=1e300", "beyond"});
 }
 
+// A tile far beyond its page (fuzz_tiff's input: tiles of 268 million rows on a 13-row
+// page) is refused before its buffer is allocated; one that merely overhangs is read.
+TEST_F(TiffStackTest, TilesFarLargerThanTheirPageAreRefused) {
+  TiffLayout huge;
+  huge.tile = 4096;  // 32 MiB of 16-bit pixels for a 20 x 12 page
+  huge.compression = COMPRESSION_LZW;
+  write_libtiff(path("huge.tif"), pattern_stack(20, 12, 2, 16), huge);
+  expect_read_error(path("huge.tif"), {"huge.tif", "4096 x 4096", "20 x 12", "tile layout"});
+  TiffLayout overhang;
+  overhang.tile = 256;
+  const Stack truth = pattern_stack(20, 12, 2, 16);
+  write_libtiff(path("overhang.tif"), truth, overhang);
+  expect_same_voxels(read_stack(path("overhang.tif")), truth);
+}
+
 // ---- Bad input: one line naming the file, nothing written ------------------------------
 
 TEST_F(TiffStackTest, TruncatedFilesAreReportedNotMisread) {

@@ -51,6 +51,19 @@ Blocks page_blocks(TiffFile& file, const TiffPage& page, const std::string& wher
     b.row_bytes = static_cast<std::int64_t>(TIFFScanlineSize64(tif));
   }
   b.bytes = b.height * b.row_bytes;
+  // A tile may overhang its page (TIFF pads tiles to multiples of 16), but one beyond the
+  // padded page and larger than any real tile is corrupt, and would have us allocate for
+  // it (found by fuzz_tiff: a 13-row page in tiles of 268 million rows).
+  auto padded = [](std::int64_t n) { return (n + 15) / 16 * 16; };
+  constexpr std::int64_t kLargestOverhangingTile = std::int64_t(16) << 20;  // bytes
+  const bool overhangs = b.width > padded(page.width) || b.height > padded(page.height);
+  if (b.tiled && overhangs && b.bytes > kLargestOverhangingTile) {
+    file.fail(where + ": tiles of " + std::to_string(b.width) + " x " + std::to_string(b.height) +
+              " pixels on a page of " + std::to_string(page.width) + " x " +
+              std::to_string(page.height) +
+              ": inconsistent tile layout, expected a valid TIFF "
+              "(file corrupt?)");
+  }
   if (b.width <= 0 || b.height <= 0 || b.row_bytes < b.width * page.bits / 8) {
     file.fail(where + ": inconsistent " + (b.tiled ? "tile" : "strip") +
               " layout, expected a valid TIFF (file corrupt?)");

@@ -509,10 +509,24 @@ void add_comparison(CalibrateSummary& s, std::ostream& report, const Comparison&
   report << c.Report();
 }
 
-ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs) {
+// The twin's runs fitted to the experiment's steady state: mu_s alone, or with mu_r.
+ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
   ObservableFitOptions fo;
-  fo.degree = twin.options().degree;
-  return fit_friction_to_steady_state(twin.measured_steady_state(), runs, fo, twin.options().only);
+  fo.degree = o.degree;
+  return fo;
+}
+
+ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs) {
+  const CalibrateOptions& o = twin.options();
+  return fit_friction_to_steady_state(twin.measured_steady_state(), runs, observable_fit_options(o),
+                                      o.only);
+}
+
+JointObservableFit joint_steady_state_fit(const Twin& twin,
+                                          const std::vector<SteadyStateRun>& runs) {
+  const CalibrateOptions& o = twin.options();
+  return fit_frictions_to_steady_state(twin.measured_steady_state(), runs,
+                                       observable_fit_options(o), o.only);
 }
 
 // Strictly inside the range of `simulated`.
@@ -529,10 +543,7 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
   line << std::setprecision(3) << "the design's fit: ";
   FrictionRunSpec at;
   if (o.joint()) {
-    ObservableFitOptions fo;
-    fo.degree = o.degree;
-    const JointObservableFit f =
-        fit_frictions_to_steady_state(twin.measured_steady_state(), runs, fo, o.only);
+    const JointObservableFit f = joint_steady_state_fit(twin, runs);
     at = {three_digits(f.mu_s), 0, three_digits(f.mu_r)};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << "), mu_r = " << f.mu_r << " (" << f.mu_r_ci95[0] << " - " << f.mu_r_ci95[1] << ")";
@@ -560,11 +571,11 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
             (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") + ", seeds " +
             std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(o.refine - 1));
     twin.say(line);
-    std::vector<FrictionRunSpec> more;
     std::vector<std::uint64_t> seeds;
+    std::vector<FrictionRunSpec> more;
     for (int k = 0; k < o.refine; ++k) {
-      more.push_back({at.mu_s, twin.next_seed(k), at.mu_r});
       seeds.push_back(twin.next_seed(k));
+      more.push_back({at.mu_s, seeds.back(), at.mu_r});
     }
     twin.prepare_shared_packings(seeds);
     twin.run(more);
@@ -629,10 +640,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
                std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
-  ObservableFitOptions fo;
-  fo.degree = o.degree;
-  const SteadyState measured = twin.measured_steady_state();
-  const JointObservableFit fit = fit_frictions_to_steady_state(measured, runs, fo, o.only);
+  const JointObservableFit fit = joint_steady_state_fit(twin, runs);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;

@@ -28,7 +28,9 @@ the structure; translations as `granmem analyze` measures them, drift removed):
 mean_dr (translations, d), rattler_fraction (grains with fewer than 4 neighbours within
 1.02 d), high_coordination_fraction (7 or more), fabric_z (the contact normals' zz
 component less the mean of xx and yy), first_peak (pairs within 1.01 d over pairs
-1.05-1.10 d).
+1.05-1.10 d), compaction (the relative fall of the packing's height across the window)
+and rotation_change (the per-cycle rotation's change across it): how fast the packing
+still settles.
 """
 import argparse
 import glob
@@ -47,7 +49,7 @@ import granmem  # noqa: E402
 
 CURRENT = ["rot_disp", "bulk_packing_fraction", "coordination", "height_packing_fraction"]
 CANDIDATES = ["mean_dr", "rattler_fraction", "high_coordination_fraction", "fabric_z",
-              "first_peak"]
+              "first_peak", "compaction", "rotation_change"]
 GAP = 1.02  # neighbours within this many diameters touch, as `coordination`'s 2 % gap
 
 
@@ -75,16 +77,28 @@ def structure_of_frame(p, d):
             "first_peak": np.mean(r < 1.01) / np.mean(r > 1.05)}
 
 
+def change_across(cycles, values, window):
+    """The least-squares change of `values` across the window."""
+    return np.polyfit(cycles, values, 1)[0] * (window[1] - window[0])
+
+
 def candidates_of_run(path, window):
     run = granmem.read_run(path)
-    d = 2 * np.median(run["radius"])
+    radius = run["radius"]
+    d = 2 * np.median(radius)
     steps = list(run["step"])
+    cycles = list(range(window[0], window[1] + 1))
     per_frame = granmem.analyze(path, subtract_drift=True)["per_frame"]
     in_window = per_frame[(per_frame["frame"] >= window[0]) & (per_frame["frame"] <= window[1])]
-    values = {"mean_dr": in_window["mean_dr"].mean() / d}
-    rows = [structure_of_frame(run["position"][steps.index(c)], d)
-            for c in range(window[0], window[1] + 1)]
+    values = {"mean_dr": in_window["mean_dr"].mean() / d,
+              "rotation_change": change_across(in_window["frame"], in_window["mean_rot_disp"] / d,
+                                               window)}
+    rows = [structure_of_frame(run["position"][steps.index(c)], d) for c in cycles]
     values.update(pd.DataFrame(rows).mean().to_dict())
+    # The packing's height: its grains' extent, bottom to top (the box's section cancels).
+    height = [np.ptp(np.concatenate([z + radius, z - radius]))
+              for z in (run["position"][steps.index(c)][:, 2] for c in cycles)]
+    values["compaction"] = -change_across(cycles, np.log(height), window)
     return values
 
 

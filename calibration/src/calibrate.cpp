@@ -107,6 +107,7 @@ ObservableOptions observable_options(const CalibrateOptions& o, const Trajectory
   observe.motion.subtract_drift = o.subtract_drift;
   observe.motion.wall_distance = o.wall_distance;
   observe.rotations = h.has_axis || h.has_orientation;
+  observe.axis_noise = o.axis_noise;
   const auto& steps = experiment.steps();
   observe.window = o.window ? *o.window
                             : std::pair<std::int64_t, std::int64_t>{
@@ -125,6 +126,7 @@ ObservableOptions observable_options(const CalibrateOptions& o, const Trajectory
 // twin's: the lid moves, so grains are left out near the floor and the side walls only.
 CycleObservables measured_observables(const TrajectoryReader& experiment, ObservableOptions o) {
   o.motion.box.reset();
+  o.axis_noise = 0;  // the experiment's axes carry their own
   if (const auto& box = experiment.header().box; box && o.motion.wall_distance > 0) {
     o.motion.box = Box{box->lower, Eigen::Vector3d(box->edges(0), box->edges(1), 1e9)};
   }
@@ -613,6 +615,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["dof"] = fit.dof;
   j["n_simulations"] = s.simulations;
   j["replicas"] = o.replicas;
+  j["axis_noise_deg"] = o.axis_noise * 180 / M_PI;
   std::vector<double> simulated;
   for (const FrictionRunSpec& spec : specs)
     simulated.push_back(spec.mu_s);
@@ -863,6 +866,12 @@ void CalibrateOptions::validate() const {
     }
   }
   if (!(wall_distance >= 0)) throw Error("--wall-distance: expected a length >= 0");
+  if (!(axis_noise >= 0) || !std::isfinite(axis_noise)) {
+    throw Error("--axis-noise: expected an angle in degrees >= 0");
+  }
+  if (axis_noise > 0 && !steady) {
+    throw Error("--axis-noise: only with --observables steady-state (its rotations)");
+  }
   if (window && window->first < 1) throw Error("--window: cycles start at 1");
   if (auto_window && !steady) {
     throw Error(

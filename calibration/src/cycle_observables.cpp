@@ -4,10 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <random>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/units.hpp"
+#include "granmem/rotation/full_rotation.hpp"
 
 namespace granmem {
 namespace {
@@ -38,6 +40,28 @@ void check_rotations(const TrajectoryReader& run, const ObservableOptions& optio
     throw Error(run.file_name() +
                 ": has no cavity axes or orientations, so no rotations (leave rotations out)");
   }
+}
+
+// The frame with its hole axes, each tilted at random by `sigma` (rad, the standard
+// deviation in each of two directions across it), as a scan would locate them.
+Frame with_axis_noise(const RunHeader& h, Frame f, double sigma, std::mt19937_64& random) {
+  std::normal_distribution<double> normal(0, sigma);
+  Vectors3 axis(Eigen::Index(h.grain_count()), 3);
+  for (Eigen::Index i = 0; i < axis.rows(); ++i) {
+    const Eigen::Vector3d a =
+        h.has_axis ? Eigen::Vector3d(f.axis.row(i).transpose())
+                   : cavity_axis(Eigen::Quaterniond(f.orientation(i, 0), f.orientation(i, 1),
+                                                    f.orientation(i, 2), f.orientation(i, 3)));
+    const double tilt_u = normal(random), tilt_v = normal(random);  // drawn for every grain
+    if (!a.allFinite() || a.isZero()) {
+      axis.row(i) = a.transpose();
+      continue;
+    }
+    const Eigen::Vector3d unit = a.normalized(), u = unit.unitOrthogonal(), v = unit.cross(u);
+    axis.row(i) = (unit + tilt_u * u + tilt_v * v).normalized().transpose();
+  }
+  f.axis = std::move(axis);
+  return f;
 }
 
 }  // namespace
@@ -84,13 +108,22 @@ CycleObservables cycle_observables(const TrajectoryReader& run, const Observable
 
   const double to_d = metres / o.diameter;  // run's length unit -> diameters
   const MotionOptions motion = in_run_units(options.motion, metres);
+  // With an axis noise the frames carry noisy axes, which the rotations are measured from.
+  const bool noisy = options.rotations && options.axis_noise > 0;
+  RunHeader measured_header = h;
+  if (noisy) measured_header.has_axis = true;
+  std::mt19937_64 random(options.axis_noise_seed);
+  auto read = [&](std::size_t t) {
+    Frame f = run.read_frame(t);
+    return noisy ? with_axis_noise(h, std::move(f), options.axis_noise, random) : f;
+  };
   std::vector<Eigen::Vector3d> displacement;
-  Frame before = run.read_frame(0);
+  Frame before = read(0);
   for (std::size_t t = 1; t < steps.size(); ++t) {
-    Frame after = run.read_frame(t);
+    Frame after = read(t);
     const bool consecutive = steps[t] == steps[t - 1] + 1;
     if (consecutive) {
-      const FrameMotion m = grain_motion(h, before, after, motion);
+      const FrameMotion m = grain_motion(measured_header, before, after, motion);
       const bool pooled = steps[t] >= first && steps[t] <= last;
       double sum_dr = 0, sum_rot = 0;
       std::size_t n_rot = 0;

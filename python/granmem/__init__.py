@@ -311,7 +311,8 @@ def _frictions(value):
 def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=2,
-              refine=0, deposit="each", fit_only=False, parallel=0, progress=None, **twin):
+              refine=0, axis_noise=0, deposit="each", fit_only=False, parallel=0, progress=None,
+              **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -323,7 +324,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
-    every run.
+    every run. ``axis_noise`` (steady-state, degrees): the experiment's error in each hole
+    axis (a scan's), added to the twin's exact axes before their rotations are measured.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``
@@ -335,6 +337,7 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
-                              int(degree), int(replicas), int(refine), deposit,
+                              int(degree), int(replicas), int(refine), float(axis_noise),
+                              deposit,
                               bool(fit_only),
                               int(parallel), twin, progress)

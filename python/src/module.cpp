@@ -741,8 +741,8 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       const std::optional<std::string>& window, const std::string& noise,
                       const std::string& summaries, const std::string& wall_distance,
                       bool subtract_drift, int degree, int replicas, int refine,
-                      const std::string& deposit, bool fit_only, int parallel, const py::dict& twin,
-                      const py::object& progress) {
+                      double axis_noise_deg, const std::string& deposit, bool fit_only,
+                      int parallel, const py::dict& twin, const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
   o.out = out;
@@ -767,6 +767,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.degree = degree;
   o.replicas = replicas;
   o.refine = refine;
+  o.axis_noise = axis_noise_deg * M_PI / 180;
   if (deposit != "each" && deposit != "shared") {
     throw Error("deposit '" + deposit + "': expected each or shared");
   }
@@ -900,9 +901,9 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("noise") = "auto", py::arg("summaries") = "pooled", py::arg("wall_distance") = "0",
         py::arg("subtract_drift") = true, py::arg("degree") = CalibrateOptions{}.degree,
         py::arg("replicas") = CalibrateOptions{}.replicas,
-        py::arg("refine") = CalibrateOptions{}.refine, py::arg("deposit") = "each",
-        py::arg("fit_only") = false, py::arg("parallel") = 0, py::arg("twin") = py::dict(),
-        py::arg("progress") = py::none());
+        py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = 0.0,
+        py::arg("deposit") = "each", py::arg("fit_only") = false, py::arg("parallel") = 0,
+        py::arg("twin") = py::dict(), py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,

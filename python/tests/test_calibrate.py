@@ -49,13 +49,17 @@ def test_the_window_chosen_from_the_runs_is_the_command_lines(tmp_path, cli, exp
 
 
 def test_a_refined_design_is_the_command_lines(tmp_path, cli, experiment):
-    fit = granmem.calibrate(experiment, tmp_path / "py", **dict(FIT, refine=2), **TWIN)
+    # with a scan's axis error given to the twin's axes, as the command line's --axis-noise
+    fit = granmem.calibrate(experiment, tmp_path / "py", **dict(FIT, refine=2, axis_noise=1),
+                            **TWIN)
     assert fit["simulations"] == 10  # 4 frictions x 2 packings, and 2 packings at their fit
     assert "packing(s) more at mu_s " in fit["report"]
     out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.05,0.1,0.2,0.4",
               "--window", "2:3", "--observables", "steady-state", "--fit-only", "--refine", "2",
-              *TWIN_FLAGS)
+              "--axis-noise", "1", *TWIN_FLAGS)
     assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
+    summary = json.loads((tmp_path / "py" / "summary.json").read_text())
+    assert summary["axis_noise_deg"] == 1
 
 
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):

@@ -135,6 +135,26 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   expect_clean_failure(calibrate({"--window", "2:3", "--mu-s", "0.05,0.1,0.2,0.4", "--observables",
                                   "steady-state", "--only", "lid_angle"}),
                        {"--only", "lid_angle", "not measured", "exp.h5"});
+  // A scan's axis error added to the twin's axes (the same runs): the experiment's own
+  // rotation is measured as it is; the twin's rotations grow.
+  granmem_ok(calibrate({"--window", "2:3", "--mu-s", "0.05,0.1,0.2,0.4", "--observables",
+                        "steady-state", "--fit-only"}));
+  const std::string exact = read_text(in_work("cal/summary.json"));
+  granmem_ok(calibrate({"--window", "2:3", "--mu-s", "0.05,0.1,0.2,0.4", "--observables",
+                        "steady-state", "--fit-only", "--axis-noise", "2"}));
+  const std::string noisy = read_text(in_work("cal/summary.json"));
+  EXPECT_DOUBLE_EQ(json_value(noisy, "axis_noise_deg"), 2);
+  const auto rotation = [](const std::string& json, const char* key) {
+    const std::size_t at = json.find("\"rot_disp\"");
+    return json_value(json.substr(at), key);
+  };
+  EXPECT_DOUBLE_EQ(rotation(noisy, "experiment"), rotation(exact, "experiment"));
+  EXPECT_GT(rotation(noisy, "model_at_fit"), rotation(exact, "model_at_fit"));
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--axis-noise", "1"}),
+                       {"--axis-noise", "steady-state"});
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
+                                  "--axis-noise", "-1"}),
+                       {"--axis-noise", ">= 0"});
 }
 
 // --refine: the design's fit, then packings of new seeds at it, and the fit again on all

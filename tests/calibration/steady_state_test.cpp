@@ -76,6 +76,29 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
 }
 
+// A scan's hole axes carry an error; the twin's exact axes get one like it: each axis
+// tilted at random by sigma in each direction across it, so that a turn of kTurn between
+// two frames is measured as the Rice-distributed angle between two noisy axes, whose mean
+// square is kTurn^2 + 4 sigma^2. The same seed gives the same angles.
+TEST_F(SteadyStateTest, AnAxisNoiseAddsToTheRotationsAsAScansError) {
+  write_trajectories(path("run.h5"), cubic_run());
+  const TrajectoryReader run(path("run.h5"));
+  ObservableOptions o;
+  o.window = {1, 4};
+  const CycleObservables exact = cycle_observables(run, o);
+  o.axis_noise = 0.02;
+  const CycleObservables noisy = cycle_observables(run, o);
+  ASSERT_EQ(noisy.rot_disp.size(), exact.rot_disp.size());
+  double mean_square = 0;
+  for (double r : noisy.rot_disp)
+    mean_square += std::pow(2 * r, 2) / double(noisy.rot_disp.size());  // angle = 2 rot / d
+  EXPECT_NEAR(mean_square, kTurn * kTurn + 4 * 0.02 * 0.02, 0.08 * 0.002);
+  for (double r : exact.rot_disp)
+    EXPECT_NEAR(r, kTurn / 2, 1e-12);
+  EXPECT_EQ(noisy.dr, exact.dr);  // positions are not touched
+  EXPECT_EQ(cycle_observables(run, o).rot_disp, noisy.rot_disp);
+}
+
 // A scan's located radii come out small (blur, threshold): measured at the grains' known
 // radius, the structure is the lattice's again; at the located radii it is not.
 TEST_F(SteadyStateTest, TheStructureIsMeasuredAtTheGrainsKnownRadiusWhenGiven) {

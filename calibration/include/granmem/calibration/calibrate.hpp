@@ -47,6 +47,9 @@ struct CalibrateOptions {
   std::string noise = "auto";  // displacements: none, fit, auto, or a value in voxels
   bool per_cycle = false;      // displacements: each cycle's CDF instead of the window's
   double wall_distance = 0;    // m: grains closer to a container face are left out
+  // rad: steady state: the experiment's error in each hole axis (a scan's), added to the
+  // twin's exact axes before their rotations are measured (cycle_observables.hpp); 0: none.
+  double axis_noise = 0;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
   int degree = 2;              // of the polynomial in ln mu_s through the runs
   int replicas = 2;            // packings per friction (seeds seed, seed + 1, ...)

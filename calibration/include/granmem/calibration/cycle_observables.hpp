@@ -28,6 +28,12 @@ struct ObservableOptions {
   // percent off does not bias them). 0: twice the run's median grain radius.
   double diameter = 0;
   bool rotations = true;  // rotational displacements (an error if the run has no axes)
+  // rad: a scan's error in each hole axis, added to the run's axes before the rotations are
+  // measured (a simulation's axes are exact, a scan's are not, and the error adds to every
+  // measured rotation): the standard deviation of the axis' tilt in each direction across
+  // it. 0: none.
+  double axis_noise = 0;
+  std::uint64_t axis_noise_seed = 1;
 };
 
 // Lengths in grain diameters.

@@ -111,7 +111,8 @@ std::string design_tics(const std::vector<double>& runs) {
     return a.second != b.second ? a.second > b.second : digits(a.first) < digits(b.first);
   });
   std::set<double> tics;
-  for (const auto& [x, n] : by_runs) {
+  for (const auto& run : by_runs) {
+    const double x = run.first;  // a plain name: C++17 lambdas cannot capture a binding
     const bool crowded = std::any_of(tics.begin(), tics.end(),
                                      [&](double t) { return std::max(x / t, t / x) < 1.2; });
     if (!crowded) tics.insert(x);

@@ -7,6 +7,7 @@
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/memory_budget.hpp"
+#include "granmem/core/random.hpp"
 #include "granmem/sim/spatial_order.hpp"
 
 namespace granmem {
@@ -99,15 +100,19 @@ Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
     const Eigen::Vector3d site(margin + spacing * double(in_layer % per_row),
                                margin + spacing * double(in_layer / per_row),
                                r_max + spacing * double(layer));
-    const Eigen::Vector3d shift(jitter * (2 * random.uniform() - 1),
-                                jitter * (2 * random.uniform() - 1), jitter * random.uniform());
+    // Each vector's draws are made last component first, in statements of their own
+    // (normal_vector in random.hpp), so that every compiler deposits the same packing.
+    const double shift_z = jitter * random.uniform();
+    const double shift_y = jitter * (2 * random.uniform() - 1);
+    const double shift_x = jitter * (2 * random.uniform() - 1);
+    const Eigen::Vector3d shift(shift_x, shift_y, shift_z);
     const double r = o.radius * (1 + o.polydispersity * (2 * random.uniform() - 1));
     grains.add(k, site + shift, r, physics.density);
-    grains.v.back() =
-        o.insertion_speed * Eigen::Vector3d(random.normal(), random.normal(), random.normal());
+    grains.v.back() = o.insertion_speed * normal_vector(random);
     // Random orientation: a normalised Gaussian quaternion is uniform on rotations.
-    Eigen::Quaterniond q(random.normal(), random.normal(), random.normal(), random.normal());
-    grains.q.back() = q.normalized();
+    const double qz = random.normal(), qy = random.normal(), qx = random.normal();
+    const double qw = random.normal();
+    grains.q.back() = Eigen::Quaterniond(qw, qx, qy, qz).normalized();
   }
   return grains;
 }

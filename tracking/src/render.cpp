@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/random.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/tracking/partial_volume.hpp"
 #include "seeded_random.hpp"
@@ -621,7 +622,7 @@ std::vector<RenderedGrain> rendered_grains(const Frame& frame, const RunHeader& 
     if (!(axis.allFinite() && axis.norm() > 0)) {
       seeded_random::Stream random(seed, kAxisStream, static_cast<std::uint64_t>(g.id));
       do {
-        axis = Eigen::Vector3d(random.normal(), random.normal(), random.normal());
+        axis = normal_vector(random);  // the same on every compiler
       } while (!(axis.norm() > 1e-12));
     }
     g.axis = axis.normalized();

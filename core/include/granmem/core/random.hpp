@@ -1,5 +1,6 @@
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <random>
 
@@ -17,5 +18,14 @@ class Random {
  private:
   std::mt19937_64 engine_;
 };
+
+// Three standard normal draws of `source` (anything with normal()) as a vector, drawn z,
+// y, x in statements of their own: C++ leaves the order of a constructor's arguments to the
+// compiler, and this is the one GCC used, so that every compiler draws the same vector.
+template <class Source>
+Eigen::Vector3d normal_vector(Source& source) {
+  const double z = source.normal(), y = source.normal(), x = source.normal();
+  return {x, y, z};
+}
 
 }  // namespace granmem

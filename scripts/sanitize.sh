@@ -2,7 +2,8 @@
 # The sanitizer and fuzzing check (issue 19): builds granmem's libraries, their unit tests
 # and the fuzz harnesses with clang, AddressSanitizer and UndefinedBehaviorSanitizer (and
 # libFuzzer's coverage) in build-asan/ (SANITIZE_BUILD), runs the unit tests that take seconds under it
-# (core, tracking, rotation, sim; the end-to-end and long tests run in the normal build),
+# (core, tracking, rotation, sim, calibration; the end-to-end and long tests run in the
+# normal build),
 # then each fuzz harness for FUZZ_SECONDS (default 60) from its seed corpus in
 # fuzz/corpus/. Any sanitizer report, test failure or fuzz crash fails it; a crashing input
 # is left in build-asan/fuzz/ (crash-*), to add to fuzz/corpus/<harness> with a test.
@@ -19,7 +20,7 @@ CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS="$flags -fsanitize=fuzzer-no-link" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
 cmake --build "$build" -j"$jobs" --target granmem_core_tests granmem_tracking_tests \
-  granmem_rotation_tests granmem_sim_tests "${harnesses[@]}"
+  granmem_rotation_tests granmem_sim_tests granmem_calibration_tests "${harnesses[@]}"
 
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
@@ -29,7 +30,8 @@ export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 slow="ReadoutSweep\.|Locate\.|SettledPile\.|HoleAxis\.NoTiltUnderABlurWiderAlongZ"
 slow+="|CyclicSamples\.|Illumination\.|Restart\.(AKept|Resumed|Stopped)"
 slow+="|Render\.(SameSeed|HoleLies)|StackMemoryTest\."
-ctest --test-dir "$build" --output-on-failure -j"$jobs" -L "core|tracking|rotation|sim" -E "$slow"
+slow+="|FrictionFit\.(Realization|PerCycle)|FrictionSeriesTest\.EachRun"
+ctest --test-dir "$build" --output-on-failure -j"$jobs" -L "core|tracking|rotation|sim|calibration" -E "$slow"
 
 mkdir -p "$build/fuzz/work"
 for harness in "${harnesses[@]}"; do

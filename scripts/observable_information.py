@@ -120,14 +120,20 @@ def current_observables(study):
     return table
 
 
-def gls_fit(runs, experiment, names):
-    """ln mu_s of `experiment` from `runs`: GLS against each observable's quadratic in ln
-    mu_s, covariance of the residuals shrunk to its diagonal by m / (m + spare runs)."""
+def quadratic_trend(runs, names):
+    """Each observable's quadratic in ln mu_s through the runs: coefficients (3 x m), the
+    runs' residuals about it, and the log frictions."""
     x = np.log(runs["mu_s"].to_numpy())
     X = np.vstack([np.ones_like(x), x, x * x]).T
     Y = runs[names].to_numpy()
     B, *_ = np.linalg.lstsq(X, Y, rcond=None)
-    R = Y - X @ B
+    return B, Y - X @ B, x
+
+
+def gls_fit(runs, experiment, names):
+    """ln mu_s of `experiment` from `runs`: GLS against each observable's quadratic in ln
+    mu_s, covariance of the residuals shrunk to its diagonal by m / (m + spare runs)."""
+    B, R, x = quadratic_trend(runs, names)
     spare, m = len(runs) - 3, len(names)
     C = R.T @ R / spare
     shrink = m / (m + spare)
@@ -143,11 +149,8 @@ def gls_fit(runs, experiment, names):
 
 def resolution(table, names, mu):
     """One packing's error in ln mu_s at mu from `names` (Fisher, all runs' covariance)."""
-    x = np.log(table["mu_s"].to_numpy())
-    X = np.vstack([np.ones_like(x), x, x * x]).T
-    Y = table[names].to_numpy()
-    B, *_ = np.linalg.lstsq(X, Y, rcond=None)
-    C = np.atleast_2d(np.cov((Y - X @ B).T, ddof=3))
+    B, R, _ = quadratic_trend(table, names)
+    C = np.atleast_2d(np.cov(R.T, ddof=3))
     slope = B[1] + 2 * B[2] * np.log(mu)
     return 1 / np.sqrt(slope @ np.linalg.solve(C, slope))
 

@@ -1,5 +1,6 @@
 #include "granmem/calibration/cycle_observables.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -9,7 +10,6 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/units.hpp"
-#include "granmem/rotation/full_rotation.hpp"
 
 namespace granmem {
 namespace {
@@ -48,10 +48,7 @@ Frame with_axis_noise(const RunHeader& h, Frame f, double sigma, std::mt19937_64
   std::normal_distribution<double> normal(0, sigma);
   Vectors3 axis(Eigen::Index(h.grain_count()), 3);
   for (Eigen::Index i = 0; i < axis.rows(); ++i) {
-    const Eigen::Vector3d a =
-        h.has_axis ? Eigen::Vector3d(f.axis.row(i).transpose())
-                   : cavity_axis(Eigen::Quaterniond(f.orientation(i, 0), f.orientation(i, 1),
-                                                    f.orientation(i, 2), f.orientation(i, 3)));
+    const Eigen::Vector3d a = axis_of(h, f, std::size_t(i));
     const double tilt_u = normal(random), tilt_v = normal(random);  // drawn for every grain
     if (!a.allFinite() || a.isZero()) {
       axis.row(i) = a.transpose();
@@ -110,9 +107,13 @@ CycleObservables cycle_observables(const TrajectoryReader& run, const Observable
   const MotionOptions motion = in_run_units(options.motion, metres);
   // With an axis noise the frames carry noisy axes, which the rotations are measured from.
   const bool noisy = options.rotations && options.axis_noise > 0;
-  RunHeader measured_header = h;
-  if (noisy) measured_header.has_axis = true;
-  std::mt19937_64 random(options.axis_noise_seed);
+  RunHeader with_axes;
+  if (noisy) {
+    with_axes = h;
+    with_axes.has_axis = true;
+  }
+  const RunHeader& measured_header = noisy ? with_axes : h;
+  std::mt19937_64 random(1);  // a fixed seed: the same noise for a run each time
   auto read = [&](std::size_t t) {
     Frame f = run.read_frame(t);
     return noisy ? with_axis_noise(h, std::move(f), options.axis_noise, random) : f;

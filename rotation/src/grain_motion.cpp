@@ -20,12 +20,12 @@ Eigen::Quaterniond quaternion(const Quaternions& q, std::size_t i) {
   return Eigen::Quaterniond(q(row, 0), q(row, 1), q(row, 2), q(row, 3));  // (w, x, y, z)
 }
 
+}  // namespace
+
 Eigen::Vector3d axis_of(const RunHeader& header, const Frame& frame, std::size_t i) {
   if (header.has_axis) return frame.axis.row(static_cast<Eigen::Index>(i)).transpose();
   return cavity_axis(quaternion(frame.orientation, i));
 }
-
-}  // namespace
 
 void MotionOptions::validate() const {
   if (!(wall_distance >= 0) || !std::isfinite(wall_distance)) {

@@ -33,7 +33,6 @@ struct ObservableOptions {
   // measured rotation): the standard deviation of the axis' tilt in each direction across
   // it. 0: none.
   double axis_noise = 0;
-  std::uint64_t axis_noise_seed = 1;
 };
 
 // Lengths in grain diameters.

@@ -47,6 +47,9 @@ struct FrameMotion {
   bool has_rotation = false;                        // the run has axes or orientations
 };
 
+// Grain i's cavity axis in the frame: the run's axis, or the body z axis of its orientation.
+Eigen::Vector3d axis_of(const RunHeader& header, const Frame& frame, std::size_t i);
+
 // Displacements and rotations between `before` and `after`. The single-axis rotation uses
 // the cavity axes, or the body z axes of the orientations when the run has no axes.
 FrameMotion grain_motion(const RunHeader& header, const Frame& before, const Frame& after,

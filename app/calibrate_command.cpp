@@ -30,7 +30,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 2, refine = 0;
-    double axis_noise_deg = 0;
+    std::string axis_noise = "auto";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -49,13 +49,15 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "over which the twin's runs are steady");
   cmd->add_option("--noise", args->noise,
                   "locating noise added to the simulated positions: none, fit, a value in voxels, "
+                  "scans (the RMS of the position standard errors locate carried into the store), "
                   "or auto (fit for scans, none for simulations)")
       ->capture_default_str();
-  cmd->add_option("--axis-noise", args->axis_noise_deg,
+  cmd->add_option("--axis-noise", args->axis_noise,
                   "steady-state: the experiment's error in each hole axis, degrees (the "
-                  "standard deviation of its tilt in each direction across it; granmem's locate "
-                  "at 12 voxels a grain: ~0.4), added to the twin's exact axes before their "
-                  "rotations are measured; 0: none")
+                  "standard deviation of its tilt in each direction across it), added to the "
+                  "twin's exact axes before their rotations are measured; auto: the scans' own "
+                  "RMS axis standard error where the store has them (granmem's locate at 12 "
+                  "voxels a grain: ~0.4), else none; 0: none")
       ->capture_default_str();
   cmd->add_option("--wall-distance", args->wall_distance,
                   "leave out grains closer than this to a container face (with a unit)")
@@ -143,7 +145,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.noise = args->noise;
     o.per_cycle = args->summaries == "per-cycle";
     o.wall_distance = parse_si(args->wall_distance, Dimension::length, "m", "--wall-distance");
-    o.axis_noise = args->axis_noise_deg * M_PI / 180;
+    o.axis_noise = parse_axis_noise(args->axis_noise, "--axis-noise");
     o.subtract_drift = args->subtract_drift;
     o.degree = args->degree;
     o.replicas = args->replicas;

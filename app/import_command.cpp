@@ -23,7 +23,8 @@ void add_import(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "import",
       "Read a long-form CSV of tracked grains (frame,particle,x,y,z[,ax,ay,az][,radius]"
-      "[,qw,qx,qy,qz][,hole_contact]) or a LAMMPS text dump into a trajectory store");
+      "[,qw,qx,qy,qz][,hole_contact][,ep_x,ep_y,ep_z or ep][,axis_error]) or a LAMMPS text "
+      "dump into a trajectory store");
   cmd->add_option("table", args->table,
                   "CSV (or tab-separated) table, one row per grain per frame, or a LAMMPS dump")
       ->required()

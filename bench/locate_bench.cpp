@@ -13,6 +13,9 @@
 //                [--bits 8,16] [--threads T] [--seed S] [--out locate_bench.csv]
 //   locate_bench --bright ...   (bright grains on a dark fluid, no holes)
 //   locate_bench --big [--grains 20000] [--diameters 12] ...   (one scan, memory)
+//   locate_bench --camera-only [--noise-variance F] ...   (no flicker, streaks or fall-off;
+//                the camera's shot and read noise, their variance times F: what the
+//                standard errors count, against the actual errors)
 
 #include <omp.h>
 #include <sys/resource.h>
@@ -52,8 +55,11 @@ double peak_rss_mb() {
 int main(int argc, char** argv) {
   bench::ScanBenchOptions o;
   o.out = "locate_bench.csv";
-  bool big = false, verbose = false, bright = false;
-  const bool parsed = bench::parse_options(argc, argv, "locate_bench", o.setters(),
+  bool big = false, verbose = false, bright = false, camera_only = false;
+  double noise_variance = 1;
+  bench::Setters setters = o.setters();
+  setters["--noise-variance"] = [&](const std::string& v) { noise_variance = std::stod(v); };
+  const bool parsed = bench::parse_options(argc, argv, "locate_bench", setters,
                                            {{"--big",
                                              [&] {
                                                big = true;
@@ -63,6 +69,7 @@ int main(int argc, char** argv) {
                                                o.bits = {8};
                                              }},
                                             {"--bright", [&] { bright = true; }},
+                                            {"--camera-only", [&] { camera_only = true; }},
                                             {"--verbose", [&] { verbose = true; }}});
   if (!parsed) return 2;
   omp_set_num_threads(o.threads);
@@ -91,6 +98,11 @@ int main(int argc, char** argv) {
         for (RenderedGrain& g : scan.grains)
           g.axis = Eigen::Vector3d::Constant(NAN);
       }
+      if (camera_only) {
+        scan.options.flicker = scan.options.attenuation = scan.options.streaks_per_slice = 0;
+      }
+      scan.options.gain *= noise_variance;  // shot noise variance: gain x signal
+      scan.options.read_noise *= std::sqrt(noise_variance);
       const double pack_s = seconds(t_pack);
       for (double b : o.bits) {
         scan.options.bits = int(b);
@@ -136,8 +148,10 @@ int main(int argc, char** argv) {
                   << summary.on_edge << "), edge grains found " << s.edge_found << ", spurious "
                   << s.spurious << ", interior flagged edge " << s.interior_flagged
                   << ", edge unflagged " << s.edge_unflagged << ", bias " << s.bias.transpose()
-                  << ", max |error| " << s.max_error.transpose() << ", peak RSS " << peak_rss_mb()
-                  << " MB\n";
+                  << ", max |error| " << s.max_error.transpose() << ", standard error RMS "
+                  << s.rms_standard_error.transpose() << " (axis median "
+                  << granmem::testing::percentile(s.axis_standard_error, 0.5) << " deg), peak RSS "
+                  << peak_rss_mb() << " MB\n";
         csv << diameter << "," << dz << "," << b << "," << o.grains << "," << s.interior << ","
             << s.interior_found << "," << s.edge_found << "," << s.spurious << ","
             << s.interior_flagged << "," << s.edge_unflagged;

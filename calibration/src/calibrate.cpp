@@ -14,6 +14,7 @@
 #include "granmem/calibration/figures.hpp"
 #include "granmem/calibration/friction_fit.hpp"
 #include "granmem/calibration/observable_fit.hpp"
+#include "granmem/calibration/scan_errors.hpp"
 #include "granmem/calibration/steady_window.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/json_file.hpp"
@@ -98,16 +99,25 @@ double true_friction(const RunHeader& experiment, const std::string& key) {
   }
 }
 
+// The hole-axis error the twin's axes are given: the one asked for, else (auto) the
+// experiment's own, its scans' RMS axis standard error where its store has them (none for
+// a simulated experiment, whose axes are exact).
+double twin_axis_noise(const CalibrateOptions& o, const ScanErrors& experiment) {
+  if (o.axis_noise) return *o.axis_noise;
+  const bool steady = o.observables == CalibrationObservables::steady_state;
+  return steady && std::isfinite(experiment.axis) ? experiment.axis : 0.0;
+}
+
 // The observables' options, the same on both sides, lengths in the twin's grain diameter.
 ObservableOptions observable_options(const CalibrateOptions& o, const TrajectoryReader& experiment,
-                                     const DepositOptions& d) {
+                                     const DepositOptions& d, const ScanErrors& errors) {
   const RunHeader& h = experiment.header();
   ObservableOptions observe;
   observe.diameter = 2 * d.radius;
   observe.motion.subtract_drift = o.subtract_drift;
   observe.motion.wall_distance = o.wall_distance;
   observe.rotations = h.has_axis || h.has_orientation;
-  observe.axis_noise = o.axis_noise;
+  observe.axis_noise = twin_axis_noise(o, errors);
   const auto& steps = experiment.steps();
   observe.window = o.window ? *o.window
                             : std::pair<std::int64_t, std::int64_t>{
@@ -146,12 +156,29 @@ void check_only(const CalibrateOptions& o, const SteadyState& measured) {
   }
 }
 
-// The displacement fit's options; the locating noise from --noise and the experiment's voxel.
+// The displacement fit's options; the locating noise from --noise and the experiment's
+// voxel. scans: the scans' own standard errors as the noise, not fitted (they run 2-3x
+// under the actual errors of a rendered scan, docs/CALIBRATION.md, so auto still fits).
 FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const RunHeader& h,
-                                            double diameter, std::string* noise_model) {
+                                            const ScanErrors& errors, double diameter,
+                                            std::string* noise_model) {
   FrictionFitOptions fit;
   fit.degree = o.degree;
   fit.per_cycle = o.per_cycle;
+  if (o.noise == "scans") {
+    *noise_model = o.noise;
+    if (!h.voxel_size || !errors.position.allFinite()) {
+      throw Error(
+          "--noise scans: the experiment's store has no position standard errors "
+          "(tracked by granmem track from scans carries them)");
+    }
+    // sigma in voxels (the RMS over the axes), each axis' share in diameters.
+    fit.noise_sigma = std::sqrt(errors.position.cwiseQuotient(*h.voxel_size).squaredNorm() / 3);
+    if (!(fit.noise_sigma > 0)) return fit;  // exact positions: no noise
+    fit.noise = NoiseModel::fixed;
+    fit.noise_shape = errors.position * metres_per(h.length_unit) / diameter / fit.noise_sigma;
+    return fit;
+  }
   const std::string noise = o.noise == "auto" ? (h.voxel_size ? "fit" : "none") : o.noise;
   *noise_model = noise;
   if (noise == "none") return fit;
@@ -177,13 +204,15 @@ class Twin {
     physics_.validate("calibrate", deposit_.radius * (1 - deposit_.polydispersity));
     check_against_experiment(experiment.header(), o_.experiment.string(), settings_,
                              deposit_.box_side);
-    observe = observable_options(o_, experiment, deposit_);
+    errors = scan_errors(experiment);
+    observe = observable_options(o_, experiment, deposit_, errors);
     measured = measured_observables(experiment, observe);
     series_ = series_options();
     for (int r = 0; r < o_.replicas; ++r)
       seeds_.push_back(deposit_.seed + std::uint64_t(r));
   }
 
+  ScanErrors errors;  // the experiment's own, from its scans
   ObservableOptions observe;
   CycleObservables measured;
 
@@ -263,6 +292,11 @@ class Twin {
          << observe.window.second << "), mu_s " << mu << ", " << o_.replicas
          << " packing(s) from seed " << deposit_.seed << ", deposited "
          << (o_.preparation == TwinPreparation::each ? "at each friction" : "once per seed");
+    if (observe.axis_noise > 0) {
+      line << "; the twin's hole axes tilted by " << std::setprecision(3)
+           << observe.axis_noise * 180 / M_PI << " deg ("
+           << (o_.axis_noise ? "--axis-noise" : "the experiment's RMS axis standard error") << ")";
+    }
     say(line.str());
   }
 
@@ -615,7 +649,10 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["dof"] = fit.dof;
   j["n_simulations"] = s.simulations;
   j["replicas"] = o.replicas;
-  j["axis_noise_deg"] = o.axis_noise * 180 / M_PI;
+  j["axis_noise_deg"] = twin.observe.axis_noise * 180 / M_PI;
+  j["axis_noise_from"] = o.axis_noise                  ? "given"
+                         : twin.observe.axis_noise > 0 ? "experiment"
+                                                       : "none";
   std::vector<double> simulated;
   for (const FrictionRunSpec& spec : specs)
     simulated.push_back(spec.mu_s);
@@ -859,17 +896,17 @@ void CalibrateOptions::validate() const {
                 std::to_string(needed) + " (degree " + std::to_string(degree) + " + 1" +
                 (replicas > 1 ? "" : ", and one more to measure the runs' scatter") + ")");
   }
-  if (noise != "auto" && noise != "fit" && noise != "none") {
+  if (noise != "auto" && noise != "fit" && noise != "none" && noise != "scans") {
     const Quantity q = parse_quantity(noise, "--noise");
     if (!q.unit.empty() || !(q.value >= 0)) {
-      throw Error("--noise '" + noise + "': expected none, fit, auto or voxels (0.05)");
+      throw Error("--noise '" + noise + "': expected none, fit, scans, auto or voxels (0.05)");
     }
   }
   if (!(wall_distance >= 0)) throw Error("--wall-distance: expected a length >= 0");
-  if (!(axis_noise >= 0) || !std::isfinite(axis_noise)) {
-    throw Error("--axis-noise: expected an angle in degrees >= 0");
+  if (axis_noise && (!(*axis_noise >= 0) || !std::isfinite(*axis_noise))) {
+    throw Error("--axis-noise: expected auto or an angle in degrees >= 0");
   }
-  if (axis_noise > 0 && !steady) {
+  if (axis_noise && *axis_noise > 0 && !steady) {
     throw Error("--axis-noise: only with --observables steady-state (its rotations)");
   }
   if (window && window->first < 1) throw Error("--window: cycles start at 1");
@@ -905,8 +942,8 @@ CalibrateSummary calibrate(const CalibrateOptions& options) {
   const bool steady = options.observables == CalibrationObservables::steady_state;
   if (steady) check_only(options, twin.measured_steady_state());
   std::string noise_model;
-  const FrictionFitOptions fit_options =
-      displacement_fit_options(options, experiment.header(), twin.observe.diameter, &noise_model);
+  const FrictionFitOptions fit_options = displacement_fit_options(
+      options, experiment.header(), twin.errors, twin.observe.diameter, &noise_model);
   fs::create_directories(options.out / "runs");
   twin.announce();
   twin.prepare_shared_packings();
@@ -924,6 +961,15 @@ CalibrateSummary calibrate(const CalibrateOptions& options) {
   }
   s.report_ = report.str();
   return s;
+}
+
+std::optional<double> parse_axis_noise(const std::string& text, const std::string& option) {
+  if (trim(text) == "auto") return std::nullopt;
+  const Quantity q = parse_quantity(text, option);
+  if ((!q.unit.empty() && q.unit != "deg") || !(q.value >= 0) || !std::isfinite(q.value)) {
+    throw Error(option + " '" + text + "': expected auto or an angle in degrees >= 0");
+  }
+  return q.value * M_PI / 180;
 }
 
 std::vector<double> parse_frictions(const std::string& text, const std::string& option) {

@@ -262,20 +262,27 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
   if (panels.empty()) throw Error("observable fit figure: no observable");
   const int columns = panels.size() > 4 ? 3 : std::min<int>(2, int(panels.size()));
   const int rows = (int(panels.size()) + columns - 1) / columns;
-  double lowest = std::min(ci95[0], mu_s), highest = std::max(ci95[1], mu_s);
+  // The range: the design's frictions and the fit, with the interval where it is finite
+  // (one that reaches 0 or infinity, an observable that cannot bound it, runs to the edge).
+  double lowest = mu_s, highest = mu_s;
   for (const ObservablePanel& panel : panels) {
     for (double m : panel.run_mu_s) {
       lowest = std::min(lowest, m);
       highest = std::max(highest, m);
     }
   }
+  if (ci95[0] > 0) lowest = std::min(lowest, ci95[0]);
+  if (std::isfinite(ci95[1])) highest = std::max(highest, ci95[1]);
+  lowest /= 1.25;
+  highest *= 1.25;
   std::ostringstream data, plot;
   data.precision(8);
   plot << "set multiplot layout " << rows << "," << columns << " title " << quoted(title)
        << "\nset logscale x\nset xlabel \"mu_s\"\nset key off\nset grid\n"
-       << "set xrange [" << lowest / 1.25 << ":" << highest * 1.25 << "]\nset xtics "
+       << "set xrange [" << lowest << ":" << highest << "]\nset xtics "
        << design_tics(panels.front().run_mu_s) << "\n"
-       << "set object 1 rect from " << ci95[0] << ", graph 0 to " << ci95[1]
+       << "set object 1 rect from " << std::max(ci95[0], lowest) << ", graph 0 to "
+       << std::min(ci95[1], highest)
        << ", graph 1 behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
        << "set arrow 1 from " << mu_s << ", graph 0 to " << mu_s
        << ", graph 1 nohead lw 2 lc rgb \"#b2182b\"\n";

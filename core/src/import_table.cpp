@@ -108,8 +108,9 @@ Scaling scaling_of(const ImportOptions& options) {
 }
 
 const std::vector<std::string> kRequiredColumns{"frame", "particle", "x", "y", "z"};
-const std::vector<std::string> kOptionalColumns{"ax", "ay", "az", "radius", "hole_contact",
-                                                "qw", "qx", "qy", "qz"};
+const std::vector<std::string> kOptionalColumns{"ax",   "ay",   "az",   "radius",    "hole_contact",
+                                                "qw",   "qx",   "qy",   "qz",        "ep",
+                                                "ep_x", "ep_y", "ep_z", "axis_error"};
 const std::vector<std::string> kOrientation{"qw", "qx", "qy", "qz"};
 
 // A row's orientation (qw, qx, qy, qz; scalar first, as LAMMPS and trajectory_table write
@@ -132,6 +133,10 @@ void read_orientation(const Table& t, std::size_t r, const std::string& where, F
 // from the table or from the options, not both.
 struct Layout {
   bool axis = false, orientation = false, hole_contact = false, radius = false;
+  // A scan's standard errors: per axis (ep_x, ep_y, ep_z) or trackpy's one `ep` for all
+  // three; the axis' (rad).
+  std::vector<std::string> position_error;
+  bool axis_error = false;
 };
 
 Layout layout_of(const Table& t, const Source& csv, const ImportOptions& options) {
@@ -153,6 +158,16 @@ Layout layout_of(const Table& t, const Source& csv, const ImportOptions& options
     throw Error(csv.name + ": has a radius column; --radius is for tables without one");
   }
   l.hole_contact = t.has("hole_contact");
+  const bool per_axis = t.has("ep_x") || t.has("ep_y") || t.has("ep_z");
+  if (per_axis && !(t.has("ep_x") && t.has("ep_y") && t.has("ep_z"))) {
+    throw Error(csv.name + ": a position error per axis needs all three columns ep_x, ep_y, ep_z");
+  }
+  if (per_axis && t.has("ep")) {
+    throw Error(csv.name + ": give the position error as ep or as ep_x, ep_y, ep_z, not both");
+  }
+  if (per_axis) l.position_error = {"ep_x", "ep_y", "ep_z"};
+  if (t.has("ep")) l.position_error = {"ep", "ep", "ep"};
+  l.axis_error = t.has("axis_error");
   return l;
 }
 
@@ -188,6 +203,8 @@ Trajectories empty_run(const Labels& labels, const Layout& layout, const Scaling
   h.has_axis = layout.axis;
   h.has_hole_contact = layout.hole_contact;
   h.has_orientation = layout.orientation;
+  h.has_position_error = !layout.position_error.empty();
+  h.has_axis_error = layout.axis_error;
   if (layout.orientation && options.voxel_size && (scale.array() != scale.x()).any()) {
     throw Error(csv.name +
                 ": orientations with voxels of unequal sides would need turning; "
@@ -237,6 +254,11 @@ class RowReader {
     if (layout_.axis) read_axis(r, line, frame, row);
     if (layout_.orientation) read_orientation(t_, r, at(csv_, line), frame, row);
     if (layout_.hole_contact) frame.hole_contact[gi] = hole_contact(r, line);
+    for (std::size_t a = 0; a < layout_.position_error.size(); ++a) {
+      frame.position_error(row, Eigen::Index(a)) =
+          standard_error(layout_.position_error[a], r, line) * scale_[Eigen::Index(a)];
+    }
+    if (layout_.axis_error) frame.axis_error[gi] = standard_error("axis_error", r, line);
     if (layout_.radius) add_radius(r, line, gi);
   }
 
@@ -305,6 +327,16 @@ class RowReader {
       throw Error(at(csv_, line) + ", column 'hole_contact': expected 0 or 1");
     }
     return static_cast<std::uint8_t>(flag);
+  }
+
+  // A standard error: empty or nan where unknown, else a finite number >= 0.
+  double standard_error(const std::string& column, std::size_t r, std::size_t line) const {
+    const double e = t_[column].values[r];
+    if (!std::isnan(e) && !(e >= 0 && std::isfinite(e))) {
+      throw Error(at(csv_, line) + ", column '" + column +
+                  "': expected a standard error (a finite number >= 0) or nothing");
+    }
+    return e;
   }
 
   void add_radius(std::size_t r, std::size_t line, std::size_t grain) {

@@ -59,6 +59,8 @@ std::string run_info(const std::filesystem::path& store) {
   if (h.has_axis) out << ", cavity axis";
   if (h.has_orientation) out << ", orientation";
   if (h.has_hole_contact) out << ", hole contact flag";
+  if (h.has_position_error) out << ", position standard errors";
+  if (h.has_axis_error) out << ", axis standard errors";
   out << "\n";
   if (!run.observables().empty()) {
     out << "  observables";

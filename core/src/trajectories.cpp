@@ -17,6 +17,8 @@ Frame Frame::unknown(const RunHeader& header) {
   if (header.has_axis) frame.axis = Vectors3::Constant(n, 3, nan);
   if (header.has_orientation) frame.orientation = Quaternions::Constant(n, 4, nan);
   if (header.has_hole_contact) frame.hole_contact.assign(header.grain_count(), 0);
+  if (header.has_position_error) frame.position_error = Vectors3::Constant(n, 3, nan);
+  if (header.has_axis_error) frame.axis_error.assign(header.grain_count(), nan);
   return frame;
 }
 
@@ -27,15 +29,19 @@ void check_frame(const RunHeader& header, const Frame& frame, const std::string&
   };
   expect(frame.position.rows() == n, "position has " + std::to_string(frame.position.rows()) +
                                          " rows, expected " + std::to_string(n) + " grains");
-  expect(header.has_axis ? frame.axis.rows() == n : frame.axis.rows() == 0,
-         header.has_axis ? "axis must have one row per grain" : "axis given but run has none");
-  expect(header.has_orientation ? frame.orientation.rows() == n : frame.orientation.rows() == 0,
-         header.has_orientation ? "orientation must have one row per grain"
-                                : "orientation given but run has none");
-  expect(header.has_hole_contact ? frame.hole_contact.size() == header.grain_count()
-                                 : frame.hole_contact.empty(),
-         header.has_hole_contact ? "hole_contact must have one value per grain"
-                                 : "hole_contact given but run has none");
+  // An optional field: one row (or value) per grain where the run declares it, else none.
+  auto expect_per_grain = [&](bool declared, Eigen::Index rows, const std::string& name,
+                              const char* per) {
+    expect(rows == (declared ? n : 0), declared ? name + " must have one " + per + " per grain"
+                                                : name + " given but run has none");
+  };
+  const auto values = [](const auto& v) { return static_cast<Eigen::Index>(v.size()); };
+  expect_per_grain(header.has_axis, frame.axis.rows(), "axis", "row");
+  expect_per_grain(header.has_orientation, frame.orientation.rows(), "orientation", "row");
+  expect_per_grain(header.has_hole_contact, values(frame.hole_contact), "hole_contact", "value");
+  expect_per_grain(header.has_position_error, frame.position_error.rows(), "position_error",
+                   "row");
+  expect_per_grain(header.has_axis_error, values(frame.axis_error), "axis_error", "value");
 }
 
 void check_header(const RunHeader& header, const std::string& where) {

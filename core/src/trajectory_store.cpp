@@ -18,7 +18,7 @@ constexpr const char* kGrains = "/particles/grains";
 // cycle are none, and a dimensionless quantity has no unit: those go in an attribute of
 // granmem's own, `granmem_unit`, which other readers ignore.
 bool is_h5md_unit(const std::string& unit) {
-  static const std::set<std::string> si{"m", "cm", "mm", "um", "s", "N", "J", "Pa", "kg"};
+  static const std::set<std::string> si{"m", "cm", "mm", "um", "s", "N", "J", "Pa", "kg", "rad"};
   return si.count(unit) > 0;
 }
 std::string h5md_unit(const std::string& unit) {
@@ -158,7 +158,7 @@ struct TrajectoryWriter::Impl {
   RunHeader header;
   AtomicFile out;
   h5::File file;
-  ElementWriter position, axis, orientation, hole_contact;
+  ElementWriter position, axis, orientation, hole_contact, position_error, axis_error;
   std::map<std::string, Observable> observables;
   std::vector<std::int64_t> steps;
   std::vector<double> times;
@@ -237,6 +237,14 @@ TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& path, RunHeader 
     impl_->hole_contact = ElementWriter::create<std::uint8_t>(
         f, std::string(kGrains) + "/hole_contact", {n}, "", h.time_unit);
   }
+  if (h.has_position_error) {
+    impl_->position_error = ElementWriter::create<double>(
+        f, std::string(kGrains) + "/position_error", {n, 3}, h.length_unit, h.time_unit);
+  }
+  if (h.has_axis_error) {
+    impl_->axis_error = ElementWriter::create<double>(f, std::string(kGrains) + "/axis_error", {n},
+                                                      "rad", h.time_unit);
+  }
 
   write_run_parameters(f, h);
 }
@@ -258,6 +266,8 @@ void TrajectoryWriter::append(const Frame& frame) {
   if (w.header.has_axis) w.axis.append(frame.axis.data(), frame);
   if (w.header.has_orientation) w.orientation.append(frame.orientation.data(), frame);
   if (w.header.has_hole_contact) w.hole_contact.append(frame.hole_contact.data(), frame);
+  if (w.header.has_position_error) w.position_error.append(frame.position_error.data(), frame);
+  if (w.header.has_axis_error) w.axis_error.append(frame.axis_error.data(), frame);
   w.steps.push_back(frame.step);
   w.times.push_back(frame.time);
 }
@@ -299,6 +309,8 @@ void TrajectoryWriter::commit() {
   w.axis = {};
   w.orientation = {};
   w.hole_contact = {};
+  w.position_error = {};
+  w.axis_error = {};
   w.file.close();
   // Sidecar first: if it cannot be written, an existing run of this name stays as it was;
   // and it is renamed into place first, so that a store in place (what a later call reads
@@ -358,6 +370,12 @@ TrajectoryWriter TrajectoryWriter::resume(const std::filesystem::path& path,
   }
   if (w.header.has_hole_contact) {
     w.hole_contact = ElementWriter::open(w.file, g + "/hole_contact", keep_frames);
+  }
+  if (w.header.has_position_error) {
+    w.position_error = ElementWriter::open(w.file, g + "/position_error", keep_frames);
+  }
+  if (w.header.has_axis_error) {
+    w.axis_error = ElementWriter::open(w.file, g + "/axis_error", keep_frames);
   }
   w.observables = std::move(observables);
   w.steps = std::move(steps);
@@ -552,7 +570,7 @@ struct TrajectoryReader::Impl {
   std::vector<std::int64_t> steps;
   std::vector<double> times;
   std::map<std::string, Observable> observables;
-  h5::Handle position, axis, orientation, hole_contact;
+  h5::Handle position, axis, orientation, hole_contact, position_error, axis_error;
 };
 
 TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
@@ -575,6 +593,9 @@ TrajectoryReader::TrajectoryReader(const std::filesystem::path& path)
   h.has_axis = open_element(r.file, r.group, "axis", t_count, {n, 3}, r.axis);
   h.has_orientation = open_element(r.file, r.group, "orientation", t_count, {n, 4}, r.orientation);
   h.has_hole_contact = open_element(r.file, r.group, "hole_contact", t_count, {n}, r.hole_contact);
+  h.has_position_error =
+      open_element(r.file, r.group, "position_error", t_count, {n, 3}, r.position_error);
+  h.has_axis_error = open_element(r.file, r.group, "axis_error", t_count, {n}, r.axis_error);
   read_provenance(r.file, h);
   if (stated_unit.empty())
     h.parameters["h5md/length_unit"] = "m, assumed: the file's positions have no unit";
@@ -631,6 +652,13 @@ Frame TrajectoryReader::read_frame(std::size_t t) const {
   if (r.header.has_hole_contact) {
     h5::read_frame(r.file, r.hole_contact.get(), g + "/hole_contact/value", t,
                    frame.hole_contact.data());
+  }
+  if (r.header.has_position_error) {
+    h5::read_frame(r.file, r.position_error.get(), g + "/position_error/value", t,
+                   frame.position_error.data());
+  }
+  if (r.header.has_axis_error) {
+    h5::read_frame(r.file, r.axis_error.get(), g + "/axis_error/value", t, frame.axis_error.data());
   }
   return frame;
 }

@@ -21,6 +21,11 @@ Table trajectory_table(const RunHeader& header) {
       t.add(c);
   }
   if (header.has_hole_contact) t.add("hole_contact", "", true);
+  if (header.has_position_error) {
+    for (const char* c : {"ep_x", "ep_y", "ep_z"})
+      t.add(c, length);
+  }
+  if (header.has_axis_error) t.add("axis_error", "rad");
   return t;
 }
 
@@ -36,6 +41,10 @@ void append_frame(Table& table, const RunHeader& header, const Frame& frame) {
   for (int a = 0; a < 4 && header.has_orientation; ++a)
     q[a] = column(std::string("q") + "wxyz"[a]);
   std::vector<double>* hole = header.has_hole_contact ? column("hole_contact") : nullptr;
+  std::vector<double>* ep[3] = {};
+  for (int a = 0; a < 3 && header.has_position_error; ++a)
+    ep[a] = column(std::string("ep_") + "xyz"[a]);
+  std::vector<double>* axis_error = header.has_axis_error ? column("axis_error") : nullptr;
   for (std::size_t g = 0; g < header.grain_count(); ++g) {
     const auto r = Eigen::Index(g);
     if (!frame.position.row(r).allFinite()) continue;  // not seen in this frame
@@ -50,6 +59,9 @@ void append_frame(Table& table, const RunHeader& header, const Frame& frame) {
     for (int a = 0; a < 4 && header.has_orientation; ++a)
       q[a]->push_back(frame.orientation(r, a));
     if (hole) hole->push_back(frame.hole_contact[g]);
+    for (int a = 0; a < 3 && header.has_position_error; ++a)
+      ep[a]->push_back(frame.position_error(r, a));
+    if (axis_error) axis_error->push_back(frame.axis_error[g]);
   }
 }
 

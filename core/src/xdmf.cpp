@@ -104,6 +104,14 @@ AtomicFile write_xdmf(const std::filesystem::path& h5_path, const std::string& g
       x << attribute("hole_contact", "Scalar",
                      slab(ref + "/hole_contact/value", t, frames, {n}, "UChar", 1));
     }
+    if (header.has_position_error) {
+      x << attribute("position_error", "Vector",
+                     slab(ref + "/position_error/value", t, frames, {n, 3}, "Float", 8));
+    }
+    if (header.has_axis_error) {
+      x << attribute("axis_error", "Scalar",
+                     slab(ref + "/axis_error/value", t, frames, {n}, "Float", 8));
+    }
     x << "</Grid>\n";
   }
   x << "</Grid>\n</Domain>\n</Xdmf>\n";

@@ -89,8 +89,9 @@ def locate(stack, diameter, voxel_size=None, unit="", frame=0, polarity="dark",
 
     ``stack`` is a (z, y, x) uint8/uint16 array (left unchanged); ``diameter`` in voxels
     along x (12) or a length ("5mm") with ``voxel_size`` (x, y, z) in ``unit``. Returns a
-    DataFrame: frame, particle (the detection's index), x, y, z, radius, quality, edge, and
-    with holes ax, ay, az, axis_quality, hole_contact; lengths in ``attrs["length_unit"]``
+    DataFrame: frame, particle (the detection's index), x, y, z, radius, quality, edge,
+    ep_x, ep_y, ep_z (the centre's standard errors), and with holes ax, ay, az,
+    axis_quality, axis_error (rad), hole_contact; lengths in ``attrs["length_unit"]``
     (the voxel size's unit, or voxels), the run's numbers in ``attrs["summary"]``.
     ``progress``: called with a dict ``{"line": stage}`` as each stage begins; Ctrl-C stops
     between two stages (KeyboardInterrupt)."""
@@ -112,8 +113,9 @@ def _scans(detections):
     scans = []
     for k, df in enumerate(parts):
         frame = int(df["frame"].iloc[0]) if "frame" in df.columns and len(df) else k
-        columns = _columns(df, ["x", "y", "z", "radius", "quality", "edge", "ax", "ay", "az",
-                                "axis_quality", "hole_contact"])
+        columns = _columns(df, ["x", "y", "z", "radius", "quality", "edge", "ep_x", "ep_y",
+                                "ep_z", "ax", "ay", "az", "axis_quality", "axis_error",
+                                "hole_contact"])
         n = len(df)
         # trackpy's tables have no radius, quality or edge: unknown, good, inside.
         columns.setdefault("radius", np.full(n, np.nan))
@@ -130,7 +132,7 @@ def link(detections, length_unit=None, voxel_size=None, max_displacement="auto",
     ``detections``: a list of DataFrames, one per scan in order (e.g. from ``locate``), or
     one DataFrame with a frame column (trackpy's shape). Returns the tracks as a DataFrame:
     frame, particle (the track), time, x, y, z, radius, and ax, ay, az, hole_contact where
-    the scans have axes. ``container`` ("xmin,ymin,zmin,xmax,ymax,zmax cm") or
+    the scans have axes, ep_x, ep_y, ep_z and axis_error where they have standard errors. ``container`` ("xmin,ymin,zmin,xmax,ymax,zmax cm") or
     ``container_size`` ("LX,LY,LZ cm", placed at the packing's extent in the first scan)
     moves the positions into the container's frame. ``collective_motion=False``: no
     estimate of the packing's drift and deformation between scans (``--no-collective-motion``).
@@ -161,7 +163,8 @@ def info(path):
 
 def read_run(path):
     """A trajectory store (.h5, H5MD) as a dict of numpy arrays: position (frames, grains,
-    3; NaN where not seen), axis, orientation (or None), id, radius, step, time, box,
+    3; NaN where not seen), axis, orientation, position_error (frames, grains, 3) and
+    axis_error (frames, grains; rad), a scan's standard errors (or None), id, radius, step, time, box,
     length_unit, time_unit, parameters, and observables (name -> unit, step, time, value)."""
     return _granmem.read_run(os.fspath(path))
 
@@ -175,11 +178,13 @@ def read_tracks(path):
 
 def write_run(tracks, path, length_unit=None, radius=None):
     """Writes tracks (frame, particle, x, y, z and optionally radius, ax, ay, az,
-    hole_contact) as a trajectory store that ``granmem analyze``, ``compare`` and
+    hole_contact, the standard errors ep_x, ep_y, ep_z or trackpy's ep, and axis_error in
+    rad) as a trajectory store that ``granmem analyze``, ``compare`` and
     ``calibrate`` read; written atomically. ``radius``: of every grain, for tables without
     a radius column."""
     unit = length_unit or tracks.attrs.get("length_unit", "voxel")
-    names = ["frame", "particle", "x", "y", "z", "radius", "ax", "ay", "az", "hole_contact"]
+    names = ["frame", "particle", "x", "y", "z", "radius", "ax", "ay", "az", "hole_contact",
+             "ep", "ep_x", "ep_y", "ep_z", "axis_error"]
     _granmem.write_run(_columns(tracks, names), os.fspath(path), unit,
                        None if radius is None else float(radius))
 
@@ -311,7 +316,7 @@ def _frictions(value):
 def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=2,
-              refine=0, axis_noise=0, deposit="each", fit_only=False, parallel=0, progress=None,
+              refine=0, axis_noise="auto", deposit="each", fit_only=False, parallel=0, progress=None,
               **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
@@ -325,7 +330,9 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
     every run. ``axis_noise`` (steady-state, degrees): the experiment's error in each hole
-    axis (a scan's), added to the twin's exact axes before their rotations are measured.
+    axis (a scan's), added to the twin's exact axes before their rotations are measured;
+    "auto": the scans' own RMS axis standard error where the store has them, else none.
+    ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``
@@ -337,7 +344,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
-                              int(degree), int(replicas), int(refine), float(axis_noise),
+                              int(degree), int(replicas), int(refine),
+                              axis_noise if isinstance(axis_noise, str) else repr(float(axis_noise)),
                               deposit,
                               bool(fit_only),
                               int(parallel), twin, progress)

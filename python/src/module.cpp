@@ -102,7 +102,8 @@ Table table_of(const py::dict& columns, const std::string& length_unit, const st
     }
     rows = std::size_t(a.size());
     first = false;
-    const bool is_length = name == "x" || name == "y" || name == "z" || name == "radius";
+    const bool is_length = name == "x" || name == "y" || name == "z" || name == "radius" ||
+                           name == "ep" || name == "ep_x" || name == "ep_y" || name == "ep_z";
     const bool integer =
         name == "frame" || name == "particle" || name == "edge" || name == "hole_contact";
     Column& c = t.add(name, is_length ? length_unit : "", integer);
@@ -297,6 +298,16 @@ py::dict run_arrays(const Trajectories& run) {
       h.has_orientation
           ? py::object(
                 stacked([](const Frame& f) -> const Quaternions& { return f.orientation; }, 4))
+          : py::object(py::none());
+  out["position_error"] =
+      h.has_position_error
+          ? py::object(
+                stacked([](const Frame& f) -> const Vectors3& { return f.position_error; }, 3))
+          : py::object(py::none());
+  out["axis_error"] =
+      h.has_axis_error
+          ? stacked([](const Frame& f) -> const std::vector<double>& { return f.axis_error; }, 1)
+                .attr("reshape")(frames, n)
           : py::object(py::none());
   py::dict observables;
   for (const auto& [name, o] : run.observables) {
@@ -741,7 +752,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       const std::optional<std::string>& window, const std::string& noise,
                       const std::string& summaries, const std::string& wall_distance,
                       bool subtract_drift, int degree, int replicas, int refine,
-                      double axis_noise_deg, const std::string& deposit, bool fit_only,
+                      const std::string& axis_noise, const std::string& deposit, bool fit_only,
                       int parallel, const py::dict& twin, const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
@@ -767,7 +778,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.degree = degree;
   o.replicas = replicas;
   o.refine = refine;
-  o.axis_noise = axis_noise_deg * M_PI / 180;
+  o.axis_noise = parse_axis_noise(axis_noise, "axis_noise");
   if (deposit != "each" && deposit != "shared") {
     throw Error("deposit '" + deposit + "': expected each or shared");
   }
@@ -901,7 +912,7 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("noise") = "auto", py::arg("summaries") = "pooled", py::arg("wall_distance") = "0",
         py::arg("subtract_drift") = true, py::arg("degree") = CalibrateOptions{}.degree,
         py::arg("replicas") = CalibrateOptions{}.replicas,
-        py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = 0.0,
+        py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = "auto",
         py::arg("deposit") = "each", py::arg("fit_only") = false, py::arg("parallel") = 0,
         py::arg("twin") = py::dict(), py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),

@@ -1,6 +1,7 @@
 """granmem.calibrate: the command line's friction fit from Python, stopped and resumed."""
 import json
 
+import numpy as np
 import pytest
 
 import granmem
@@ -60,6 +61,31 @@ def test_a_refined_design_is_the_command_lines(tmp_path, cli, experiment):
     assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
     summary = json.loads((tmp_path / "py" / "summary.json").read_text())
     assert summary["axis_noise_deg"] == 1
+
+
+def test_the_axis_noise_is_read_from_the_scans_standard_errors(tmp_path, experiment):
+    # The pseudo-experiment as tracked scans would give it: positions, hole axes (the body z
+    # axis) and each axis' standard error, 1 deg for every grain, its RMS then 1 deg.
+    tracks = granmem.read_tracks(experiment)
+    w, x, y, z = (tracks[c] for c in ("qw", "qx", "qy", "qz"))
+    tracks["ax"], tracks["ay"] = 2 * (x * z + w * y), 2 * (y * z - w * x)
+    tracks["az"] = 1 - 2 * (x * x + y * y)
+    tracks["axis_error"] = np.radians(1.0)
+    scans = tmp_path / "scans.h5"
+    granmem.write_run(tracks.drop(columns=["qw", "qx", "qy", "qz"]), scans, length_unit="m")
+    assert granmem.read_run(scans)["axis_error"].shape == (4, 60)
+    lines = []
+    auto = granmem.calibrate(scans, tmp_path / "cal", progress=lines.append, **FIT, **TWIN)
+    summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
+    assert summary["axis_noise_deg"] == pytest.approx(1, rel=1e-12)
+    assert summary["axis_noise_from"] == "experiment"
+    assert any("tilted by 1 deg (the experiment's RMS axis standard error)" in r.get("line", "")
+               for r in lines)
+    given = granmem.calibrate(scans, tmp_path / "cal", **dict(FIT, axis_noise=1), **TWIN)
+    # the same noise, to the rounding of an RMS
+    assert given["mu_s"] == pytest.approx(auto["mu_s"], rel=1e-6)
+    none = granmem.calibrate(scans, tmp_path / "cal", **dict(FIT, axis_noise=0), **TWIN)
+    assert none["mu_s"] != auto["mu_s"]
 
 
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):

@@ -37,6 +37,13 @@ def test_scans_to_displacements_recover_the_motion_put_in():
         detections.append(d)
     tracks = granmem.link(detections)
     assert tracks.attrs["length_unit"] == "mm"
+    # locate's standard errors go with each grain into its track: a centre to a small
+    # fraction of a voxel (0.5 mm), each axis to a degree or so.
+    for column in ("ep_x", "ep_y", "ep_z", "axis_error"):
+        np.testing.assert_array_equal(np.sort(tracks[column]),
+                                      np.sort(pd.concat(detections)[column]))
+    assert 0 < tracks[["ep_x", "ep_y", "ep_z"]].to_numpy().max() < 0.05
+    assert 0 < np.nanmedian(np.degrees(tracks["axis_error"])) < 2
     assert tracks.attrs["summary"]["tracks"] == 18
     assert tracks.attrs["summary"]["scans"][1]["linked_fraction"] == 1.0
     moved = granmem.motion(tracks, before=0, after=1)

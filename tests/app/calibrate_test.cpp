@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "granmem/core/trajectory_store.hpp"
 #include "run_granmem.hpp"
 
 namespace granmem::testing {
@@ -155,6 +156,31 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--axis-noise", "-1"}),
                        {"--axis-noise", ">= 0"});
+}
+
+// --noise scans: the locating noise is the scans' own, the RMS of the position standard
+// errors in the store, not fitted. The pseudo-experiment as scans of 0.1 mm voxels (0.15
+// along z) would store it: each centre known to 0.05, 0.05 and 0.075 mm (half a voxel).
+TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
+  Trajectories run = read_trajectories(in_work("exp.h5"));
+  run.header.voxel_size = Eigen::Vector3d(1e-4, 1e-4, 1.5e-4);
+  run.header.has_position_error = true;
+  for (Frame& f : run.frames)
+    f.position_error = Eigen::RowVector3d(5e-5, 5e-5, 7.5e-5).replicate(f.position.rows(), 1);
+  write_trajectories(in_work("scans.h5"), run);
+  std::vector<std::string> a{
+      "calibrate", "--experiment", "scans.h5",         "--out",   "cal",  "--window",
+      "1:3",       "--mu-s",       "0.05,0.1,0.2,0.4", "--noise", "scans"};
+  a.insert(a.end(), kTwin.begin(), kTwin.end());
+  granmem_ok(a);
+  const std::string json = read_text(in_work("cal/summary.json"));
+  EXPECT_NE(json.find("\"noise_model\": \"scans\""), std::string::npos) << json;
+  EXPECT_NEAR(json_value(json, "noise_sigma_voxel"), 0.5, 1e-12);
+  EXPECT_EQ(json_value(json, "noise_sigma_error"), 0);  // given, not fitted
+  // A store without them: one clear error.
+  expect_clean_failure(
+      calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4", "--noise", "scans"}),
+      {"--noise scans", "no position standard errors"});
 }
 
 // --refine: the design's fit, then packings of new seeds at it, and the fit again on all

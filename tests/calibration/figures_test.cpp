@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "temp_dir.hpp"
@@ -31,6 +33,27 @@ TEST_F(Figures, RunNamesAreShownAsGiven) {
   EXPECT_NE(svg.find("a^b{c}"), std::string::npos);
   // The script a user draws again keeps the escapes.
   EXPECT_NE(read_all(dir_ / "pdf.gp").find("granmem\\\\_seed1"), std::string::npos);
+}
+
+// An observable that cannot bound the friction gives an interval reaching 0 and infinity:
+// the figure is still drawn, over the design's frictions, the band to its edges.
+TEST_F(Figures, AnUnboundedIntervalIsDrawnToTheEdges) {
+  ObservablePanel panel;
+  panel.label = "rotational displacement (d)";
+  panel.run_mu_s = {0.05, 0.1, 0.2, 0.4};
+  panel.run_value = {0.04, 0.04, 0.038, 0.039};
+  panel.run_packing = {0, 0, 0, 0};
+  panel.curve_mu_s = panel.run_mu_s;
+  panel.curve = panel.run_value;
+  panel.experiment = 0.034;
+  panel.experiment_error = 0.012;
+  const auto written =
+      plot_observable_fit(dir_, "fit", {panel}, 0.075, {0, std::numeric_limits<double>::infinity()},
+                          std::nan(""), "unbounded");
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "fit.png"));
+  const std::string gp = read_all(dir_ / "fit.gp");
+  EXPECT_EQ(gp.find("inf"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("set xrange [0.04:0.5]"), std::string::npos) << gp;
 }
 
 }  // namespace

@@ -177,6 +177,37 @@ TEST_F(ImportTable, AnisotropicVoxelsScalePositionsAxesAndRadius) {
   EXPECT_EQ(summary.length_unit, "mm");
 }
 
+TEST_F(ImportTable, StandardErrorsAreScaledAsThePositionsAndKeptUnknownWhereEmpty) {
+  // trackpy's one `ep`, in voxels of 0.5, 0.25, 2 mm: each axis' error scaled as its
+  // coordinate; the axis' error (rad) kept as given.
+  const auto file = path("errors.csv");
+  write_text(file,
+             "frame,particle,x,y,z,ep,axis_error\n"
+             "0,1,2,4,1,0.1,0.01\n"
+             "0,2,10,20,30,,\n");
+  ImportOptions options;
+  options.voxel_size = Eigen::Vector3d(0.5, 0.25, 2.0);
+  options.voxel_size_unit = "mm";
+  const Trajectories run = import_table(file, options);
+  ASSERT_TRUE(run.header.has_position_error);
+  ASSERT_TRUE(run.header.has_axis_error);
+  const Frame& f = run.frames[0];
+  EXPECT_DOUBLE_EQ(f.position_error(0, 0), 0.05);
+  EXPECT_DOUBLE_EQ(f.position_error(0, 1), 0.025);
+  EXPECT_DOUBLE_EQ(f.position_error(0, 2), 0.2);
+  EXPECT_TRUE(f.position_error.row(1).array().isNaN().all());
+  EXPECT_EQ(f.axis_error[0], 0.01);
+  EXPECT_TRUE(std::isnan(f.axis_error[1]));
+
+  // Per axis, in lengths.
+  write_text(file, "frame,particle,x,y,z,ep_x,ep_y,ep_z\n0,1,2,4,1,0.1,0.2,0.3\n");
+  ImportOptions in_mm;
+  in_mm.length_unit = "mm";
+  const Trajectories per_axis = import_table(file, in_mm);
+  EXPECT_FALSE(per_axis.header.has_axis_error);
+  expect_row(per_axis.frames[0].position_error, 0, 0.1, 0.2, 0.3);
+}
+
 TEST_F(ImportTable, RadiusOptionIsTheFallbackForTablesWithoutRadius) {
   const auto file = path("tracks.csv");
   write_text(file, "frame,particle,x,y,z\n0,1,1,2,3\n0,2,4,5,6\n");
@@ -296,6 +327,10 @@ TEST_F(ImportTable, BadFlagsAndRadiiNameTheLine) {
   expect_error(head + "0,2,1,1,1,\n", "line 3, column 'hole_contact'");
   expect_error("frame,particle,x,y,z,radius\n0,1,1,1,1,-2\n", "line 2, column 'radius'");
   expect_error("frame,particle,x,y,z,radius\n0,1,1,1,1,0\n", "line 2, column 'radius'");
+  expect_error("frame,particle,x,y,z,ep\n0,1,1,1,1,-0.1\n", "line 2, column 'ep'");
+  expect_error("frame,particle,x,y,z,axis_error\n0,1,1,1,1,inf\n", "line 2, column 'axis_error'");
+  expect_error("frame,particle,x,y,z,ep_x,ep_y\n0,1,1,1,1,1,1\n", "all three columns ep_x");
+  expect_error("frame,particle,x,y,z,ep,ep_x,ep_y,ep_z\n0,1,1,1,1,1,1,1,1\n", "not both");
 }
 
 TEST_F(ImportTable, BadOptionsAreErrors) {

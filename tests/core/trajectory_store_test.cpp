@@ -32,7 +32,8 @@ using testing::error_message;
 namespace fs = std::filesystem;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// A random run with every optional part: axes, orientations, hole_contact, box, voxel size,
+// A random run with every optional part: axes, orientations, hole_contact, a scan's standard
+// errors (position and axis), box, voxel size,
 // radii (one unknown), scattered ids, observables, parameters; grain (t+1) % N is missing in
 // frame t (NaN position and axis), and a few extreme values are planted.
 Trajectories random_run(std::uint64_t seed, std::size_t frames, std::size_t grains) {
@@ -57,6 +58,7 @@ Trajectories random_run(std::uint64_t seed, std::size_t frames, std::size_t grai
   h.box = Box{Eigen::Vector3d(-1.5, 0.25, u(rng)), Eigen::Vector3d(10.0 / 3.0, 7.0, 1e-3)};
   h.voxel_size = Eigen::Vector3d(0.1, 0.1, 0.075);
   h.has_axis = h.has_orientation = h.has_hole_contact = true;
+  h.has_position_error = h.has_axis_error = true;
   h.creator_name = "granmem-test";
   h.creator_version = "9.8.7-test";
   h.author = "A. Tester";
@@ -76,6 +78,8 @@ Trajectories random_run(std::uint64_t seed, std::size_t frames, std::size_t grai
       if (i == (t + 1) % grains) continue;  // missing grain: NaN position and axis
       f.position.row(r) = Eigen::Vector3d(u(rng), u(rng), u(rng));
       f.axis.row(r) = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+      f.position_error.row(r) = Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseAbs() * 1e-5;
+      f.axis_error[i] = std::abs(u(rng)) * 1e-5;
     }
     run.frames.push_back(std::move(f));
   }
@@ -135,6 +139,8 @@ void expect_same_header(const RunHeader& a, const RunHeader& b) {
   EXPECT_EQ(a.has_axis, b.has_axis);
   EXPECT_EQ(a.has_orientation, b.has_orientation);
   EXPECT_EQ(a.has_hole_contact, b.has_hole_contact);
+  EXPECT_EQ(a.has_position_error, b.has_position_error);
+  EXPECT_EQ(a.has_axis_error, b.has_axis_error);
   EXPECT_EQ(a.creator_name, b.creator_name);
   EXPECT_EQ(a.creator_version, b.creator_version);
   EXPECT_EQ(a.author, b.author);
@@ -154,6 +160,12 @@ void expect_same_frame(const Frame& a, const Frame& b, std::size_t t) {
   EXPECT_TRUE(same_bits(a.orientation.data(), b.orientation.data(),
                         std::size_t(a.orientation.size()), at + "orientation"));
   EXPECT_EQ(a.hole_contact, b.hole_contact) << at;
+  ASSERT_EQ(a.position_error.rows(), b.position_error.rows()) << at;
+  EXPECT_TRUE(same_bits(a.position_error.data(), b.position_error.data(),
+                        std::size_t(a.position_error.size()), at + "position_error"));
+  ASSERT_EQ(a.axis_error.size(), b.axis_error.size()) << at;
+  EXPECT_TRUE(
+      same_bits(a.axis_error.data(), b.axis_error.data(), a.axis_error.size(), at + "axis_error"));
 }
 
 void expect_same_observables(const std::map<std::string, Observable>& a,
@@ -379,6 +391,12 @@ TEST_F(TrajectoryStore, FrameThatDoesNotMatchTheHeaderIsRejected) {
     Frame bad_flags = run.frames[1];
     bad_flags.hole_contact.pop_back();
     EXPECT_THROW(w.append(bad_flags), Error);
+    Frame bad_errors = run.frames[1];
+    bad_errors.position_error.conservativeResize(4, 3);
+    EXPECT_THROW(w.append(bad_errors), Error);
+    Frame bad_axis_errors = run.frames[1];
+    bad_axis_errors.axis_error.push_back(0);
+    EXPECT_THROW(w.append(bad_axis_errors), Error);
     EXPECT_EQ(w.frame_count(), 1u);  // rejected frames are not counted
     Observable bad;
     bad.value = {1, 2};
@@ -398,6 +416,12 @@ TEST_F(TrajectoryStore, FrameThatDoesNotMatchTheHeaderIsRejected) {
   EXPECT_THROW(w.append(f), Error);
   f.hole_contact.clear();
   f.axis = Vectors3::Zero(2, 3);
+  EXPECT_THROW(w.append(f), Error);
+  f.axis.resize(0, 3);
+  f.position_error = Vectors3::Zero(2, 3);
+  EXPECT_THROW(w.append(f), Error);
+  f.position_error.resize(0, 3);
+  f.axis_error = {0, 0};
   EXPECT_THROW(w.append(f), Error);
 }
 
@@ -448,6 +472,9 @@ TEST_F(TrajectoryStore, EveryDatasetHasTheExpectedShapeAndUnit) {
       {"/particles/grains/axis/step", {V{3}, ""}},
       {"/particles/grains/axis/time", {V{3}, "s"}},
       {"/particles/grains/axis/value", {V{3, 4, 3}, ""}},
+      {"/particles/grains/axis_error/step", {V{3}, ""}},
+      {"/particles/grains/axis_error/time", {V{3}, "s"}},
+      {"/particles/grains/axis_error/value", {V{3, 4}, "rad"}},
       {"/particles/grains/box/edges", {V{3}, "mm"}},
       {"/particles/grains/box/offset", {V{3}, "mm"}},
       {"/particles/grains/hole_contact/step", {V{3}, ""}},
@@ -460,6 +487,9 @@ TEST_F(TrajectoryStore, EveryDatasetHasTheExpectedShapeAndUnit) {
       {"/particles/grains/position/step", {V{3}, ""}},
       {"/particles/grains/position/time", {V{3}, "s"}},
       {"/particles/grains/position/value", {V{3, 4, 3}, "mm"}},
+      {"/particles/grains/position_error/step", {V{3}, ""}},
+      {"/particles/grains/position_error/time", {V{3}, "s"}},
+      {"/particles/grains/position_error/value", {V{3, 4, 3}, "mm"}},
       {"/particles/grains/radius", {V{4}, "mm"}},
   };
   EXPECT_EQ(got, expected);
@@ -499,6 +529,8 @@ TEST_F(TrajectoryStore, XdmfSidecarDescribesEveryFrame) {
   EXPECT_EQ(count(x, ">run.h5:/particles/grains/position/value</DataItem>"), 4u);
   EXPECT_EQ(count(x, ">run.h5:/particles/grains/axis/value</DataItem>"), 4u);
   EXPECT_EQ(count(x, ">run.h5:/particles/grains/hole_contact/value</DataItem>"), 4u);
+  EXPECT_EQ(count(x, ">run.h5:/particles/grains/position_error/value</DataItem>"), 4u);
+  EXPECT_EQ(count(x, ">run.h5:/particles/grains/axis_error/value</DataItem>"), 4u);
   EXPECT_EQ(count(x, ">run.h5:/particles/grains/radius</DataItem>"), 4u);
   EXPECT_EQ(count(x, ">run.h5:/particles/grains/id</DataItem>"), 4u);
   // Frame 2's coordinates: start (2,0,0), stride 1, count (1,7,3) of a [4,7,3] dataset.

@@ -23,6 +23,8 @@ Detections sample() {
   d.add({10.0, 0.125, -3.0}, 2.4, 0.5, true);
   d.axis.row(0) << 0, 0.6, 0.8;
   d.axis_quality[0] = 0.9;
+  d.axis_error[0] = 0.0125;
+  d.position_error.row(0) << 0.0025, 0.003, 0.005;
   d.hole_contact[1] = 1;
   return d;
 }
@@ -38,6 +40,10 @@ void expect_same(const Detections& a, const Detections& b) {
   EXPECT_EQ(a.axis.row(0), b.axis.row(0));
   EXPECT_TRUE(b.axis.row(1).array().isNaN().all());  // not seen stays NaN
   EXPECT_EQ(a.axis_quality[0], b.axis_quality[0]);
+  EXPECT_EQ(a.axis_error[0], b.axis_error[0]);
+  EXPECT_TRUE(std::isnan(b.axis_error[1]));
+  EXPECT_EQ(a.position_error.row(0), b.position_error.row(0));
+  EXPECT_TRUE(b.position_error.row(1).array().isNaN().all());
   EXPECT_EQ(a.hole_contact, b.hole_contact);
 }
 
@@ -51,6 +57,17 @@ TEST_F(DetectionsFile, Hdf5AndCsvRoundTripsAreExact) {
   EXPECT_EQ(h.source, "scan7.tif");
   write_detections(d, path("det.csv"));
   expect_same(d, read_detections(path("det.csv")));
+}
+
+TEST_F(DetectionsFile, AnOlderTableWithoutStandardErrorsReadsThemAsUnknown) {
+  write_text(path("old.csv"),
+             "frame,particle,x,y,z,radius,quality,edge,ax,ay,az,axis_quality,hole_contact\n"
+             "0,0,1,2,3,2.5,0.9,0,0,0,1,0.8,0\n");
+  const Detections d = read_detections(path("old.csv"));
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_TRUE(d.position_error.array().isNaN().all());
+  ASSERT_EQ(d.axis_error.size(), 1u);
+  EXPECT_TRUE(std::isnan(d.axis_error[0]));
 }
 
 TEST_F(DetectionsFile, AFileWithoutDetectionsIsRefused) {

@@ -171,6 +171,25 @@ TEST(Link, CarriesAxesAndHoleContacts) {
   EXPECT_EQ(run.frames[1].hole_contact, (std::vector<std::uint8_t>{0, 1}));
   EXPECT_DOUBLE_EQ(run.header.radius[0], 0.55);  // mean of 0.5 and 0.6
   EXPECT_DOUBLE_EQ(run.header.radius[1], 0.45);
+  // Scans without standard errors give a store without them.
+  EXPECT_FALSE(run.header.has_position_error);
+  EXPECT_FALSE(run.header.has_axis_error);
+
+  // Each detection's standard errors go with it to its track; a scan without them (the
+  // first: axis errors unknown) leaves NaN.
+  a.position_error.row(0) << 0.01, 0.02, 0.03;
+  b.position_error.row(0) << 0.04, 0.05, 0.06;  // grain 1
+  b.axis_error = {0.002, 0.001};
+  const Trajectories with_errors = link_scans({a, b}, LinkOptions{});
+  ASSERT_TRUE(with_errors.header.has_position_error);
+  ASSERT_TRUE(with_errors.header.has_axis_error);
+  EXPECT_EQ(Eigen::Vector3d(with_errors.frames[0].position_error.row(0).transpose()),
+            Eigen::Vector3d(0.01, 0.02, 0.03));
+  EXPECT_TRUE(with_errors.frames[0].position_error.row(1).array().isNaN().all());
+  EXPECT_EQ(Eigen::Vector3d(with_errors.frames[1].position_error.row(1).transpose()),
+            Eigen::Vector3d(0.04, 0.05, 0.06));
+  EXPECT_TRUE(std::isnan(with_errors.frames[0].axis_error[0]));
+  EXPECT_EQ(with_errors.frames[1].axis_error, (std::vector<double>{0.001, 0.002}));
 }
 
 TEST(Link, RejectsBadInput) {

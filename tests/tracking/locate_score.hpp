@@ -90,6 +90,12 @@ struct LocateScore {
   Eigen::Vector3d locking = Eigen::Vector3d::Zero();
   // Hole axis: angle between the lines in degrees, interior grains found.
   std::vector<double> axis_degrees;
+  // What locate says of its own errors, interior grains found: the RMS of the centres'
+  // standard errors per axis (voxels, like rms), and each axis' standard error (degrees,
+  // beside axis_degrees where both are known; the standard deviation of the tilt in the
+  // worse direction).
+  Eigen::Vector3d rms_standard_error = Eigen::Vector3d::Zero();
+  std::vector<double> axis_standard_error, axis_error_seen;
 
   double interior_fraction() const { return interior ? double(interior_found) / interior : 1.0; }
   double spurious_fraction() const { return grains ? double(spurious) / grains : 0.0; }
@@ -233,6 +239,7 @@ inline LocateScore score_locate(const Detections& d, const Table& truth,
 
   std::array<std::vector<double>, 3> frac;
   Eigen::Vector3d sum2 = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d standard_error2 = Eigen::Vector3d::Zero();
   Eigen::Vector3d sin_sum = Eigen::Vector3d::Zero(), cos_sum = Eigen::Vector3d::Zero();
   std::size_t m = 0;
   const double two_pi = 2 * 3.14159265358979323846;
@@ -250,6 +257,10 @@ inline LocateScore score_locate(const Detections& d, const Table& truth,
     const Eigen::Vector3d e = det[k] - t[i];
     sum += e;
     sum2 += e.cwiseAbs2();
+    if (d.position_error.rows() > 0) {
+      standard_error2 +=
+          d.position_error.row(Eigen::Index(k)).transpose().cwiseQuotient(voxel_size).cwiseAbs2();
+    }
     s.max_error = s.max_error.cwiseMax(e.cwiseAbs());
     for (int a = 0; a < 3; ++a) {
       frac[std::size_t(a)].push_back(det[k][a] - std::floor(det[k][a]));
@@ -264,11 +275,16 @@ inline LocateScore score_locate(const Detections& d, const Table& truth,
       if (a.allFinite() && b.allFinite()) {
         const double c = std::min(1.0, std::abs(a.normalized().dot(b.normalized())));
         s.axis_degrees.push_back(std::acos(c) * 180 / 3.14159265358979323846);
+        if (!d.axis_error.empty() && std::isfinite(d.axis_error[k])) {
+          s.axis_error_seen.push_back(s.axis_degrees.back());
+          s.axis_standard_error.push_back(d.axis_error[k] * 180 / 3.14159265358979323846);
+        }
       }
     }
   }
   if (m > 0) {
     s.rms = (sum2 / double(m)).cwiseSqrt();
+    s.rms_standard_error = (standard_error2 / double(m)).cwiseSqrt();
     s.bias = sum / double(m);
     for (int a = 0; a < 3; ++a) {
       s.ks[a] = ks_uniform(frac[std::size_t(a)]);

@@ -14,6 +14,12 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kAxisColumns[] = {"ax", "ay", "az", "axis_quality", "hole_contact"};
+const char* const kPositionErrorColumns[] = {"ep_x", "ep_y", "ep_z"};
+
+// A column's value in row i, NaN when the table has no such column.
+double value_or_nan(const Table& t, const char* column, std::size_t i) {
+  return t.has(column) ? t[column].values[i] : kNaN;
+}
 
 }  // namespace
 
@@ -24,10 +30,13 @@ void Detections::add(const Eigen::Vector3d& x, double r, double q, bool on_edge)
   radius.push_back(r);
   quality.push_back(q);
   edge.push_back(on_edge ? 1 : 0);
+  position_error.conservativeResize(n + 1, 3);
+  position_error.row(n).setConstant(kNaN);
   if (has_axis) {
     axis.conservativeResize(n + 1, 3);
     axis.row(n).setConstant(kNaN);
     axis_quality.push_back(kNaN);
+    axis_error.push_back(kNaN);
     hole_contact.push_back(0);
   }
 }
@@ -54,11 +63,17 @@ Table to_table(const Detections& d) {
     quality.values.push_back(d.quality[i]);
     edge.values.push_back(d.edge[i]);
   }
+  for (int a = 0; a < 3; ++a) {
+    Column& ep = t.add(kPositionErrorColumns[a], L);
+    for (std::size_t i = 0; i < d.size(); ++i)
+      ep.values.push_back(d.position_error(Eigen::Index(i), a));
+  }
   if (d.has_axis) {
     Column& ax = t.add("ax");
     Column& ay = t.add("ay");
     Column& az = t.add("az");
     Column& aq = t.add("axis_quality");
+    Column& ae = t.add("axis_error", "rad");
     Column& hole = t.add("hole_contact", "", true);
     for (std::size_t i = 0; i < d.size(); ++i) {
       const auto r = Eigen::Index(i);
@@ -66,6 +81,7 @@ Table to_table(const Detections& d) {
       ay.values.push_back(d.axis(r, 1));
       az.values.push_back(d.axis(r, 2));
       aq.values.push_back(d.axis_quality[i]);
+      ae.values.push_back(d.axis_error[i]);
       hole.values.push_back(d.hole_contact[i]);
     }
   }
@@ -88,10 +104,13 @@ Detections from_table(const Table& t, const std::string& where) {
   for (std::size_t i = 0; i < t.rows(); ++i) {
     d.add({t["x"].values[i], t["y"].values[i], t["z"].values[i]}, t["radius"].values[i],
           t["quality"].values[i], t["edge"].values[i] != 0);
+    const auto r = Eigen::Index(i);
+    for (int a = 0; a < 3; ++a)
+      d.position_error(r, a) = value_or_nan(t, kPositionErrorColumns[a], i);
     if (d.has_axis) {
-      const auto r = Eigen::Index(i);
       d.axis.row(r) << t["ax"].values[i], t["ay"].values[i], t["az"].values[i];
       d.axis_quality[i] = t["axis_quality"].values[i];
+      d.axis_error[i] = value_or_nan(t, "axis_error", i);
       d.hole_contact[i] = t["hole_contact"].values[i] != 0;
     }
   }
@@ -126,9 +145,9 @@ void write_detections(const Detections& d, const std::filesystem::path& path) {
 Detections read_detections(const std::filesystem::path& path) {
   const std::string where = path.string();
   if (path.extension() == ".csv") {
-    const CsvColumns c =
-        read_csv(path, {"frame", "particle", "x", "y", "z", "radius", "quality", "edge"},
-                 {"ax", "ay", "az", "axis_quality", "hole_contact"});
+    const CsvColumns c = read_csv(
+        path, {"frame", "particle", "x", "y", "z", "radius", "quality", "edge"},
+        {"ep_x", "ep_y", "ep_z", "ax", "ay", "az", "axis_quality", "axis_error", "hole_contact"});
     Detections d = from_table(c.table, where);
     d.source = where;
     // The unit is named in the header comment that write_detections() puts first.

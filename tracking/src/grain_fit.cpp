@@ -110,10 +110,13 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
       summary.status != ceres::TinySolver<GrainResiduals<kParameters>>::HIT_MAX_ITERATIONS &&
       x.allFinite();
   fit.rms = std::sqrt(2 * summary.final_cost / std::max<double>(1, double(window.points.size())));
+  if (!fit.converged) return fit;
+  const auto covariance = parameter_covariance(f, x);
+  if (!covariance) return fit;
+  fit.centre_sigma = covariance->diagonal().template head<3>().cwiseMax(0).cwiseSqrt();
   if constexpr (GrainResiduals<kParameters>::kAxis) {
-    if (fit.converged) {
-      fit.axis_sigma = axis_standard_error(f, x, 7, (f.axis0 + x[7] * f.e1 + x[8] * f.e2).norm());
-    }
+    fit.axis_sigma =
+        axis_standard_error(*covariance, 7, (f.axis0 + x[7] * f.e1 + x[8] * f.e2).norm());
   }
   return fit;
 }

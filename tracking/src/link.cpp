@@ -444,8 +444,12 @@ void check_scans(const std::vector<Detections>& scans, const LinkOptions& option
                   ", not after frame " + std::to_string(scans[t - 1].frame) + " of " + name(t - 1) +
                   ": give the scans in order, each with its own frame");
     }
-    if (d.radius.size() != d.size() || (d.has_axis && (std::size_t(d.axis.rows()) != d.size() ||
-                                                       d.hole_contact.size() != d.size()))) {
+    // The standard errors may be left empty (unknown).
+    const auto sized = [&](std::size_t n) { return n == d.size(); };
+    if (!sized(d.radius.size()) ||
+        !(d.position_error.rows() == 0 || sized(std::size_t(d.position_error.rows()))) ||
+        (d.has_axis && (!sized(std::size_t(d.axis.rows())) || !sized(d.hole_contact.size()) ||
+                        !(d.axis_error.empty() || sized(d.axis_error.size()))))) {
       throw Error("link: " + name(t) + ": detection fields of unequal lengths");
     }
     if (!d.position.allFinite()) {
@@ -557,8 +561,14 @@ class TrackBuilder {
     h.length_unit = scans_.front().length_unit;
     h.time_unit = "cycle";
     h.voxel_size = scans_.front().voxel_size;
-    for (const Detections& d : scans_)
+    // A scan's standard errors are stored where some scan has them.
+    const auto finite = [](double e) { return std::isfinite(e); };
+    for (const Detections& d : scans_) {
       h.has_axis = h.has_axis || d.has_axis;
+      h.has_position_error = h.has_position_error || d.position_error.array().isFinite().any();
+      h.has_axis_error =
+          h.has_axis_error || std::any_of(d.axis_error.begin(), d.axis_error.end(), finite);
+    }
     h.has_hole_contact = h.has_axis;
     h.id.resize(tracks_.size());
     h.radius.assign(tracks_.size(), kNaN);
@@ -595,9 +605,13 @@ class TrackBuilder {
         const Detections& d = scans_[t];
         Frame& frame = run.frames[t];
         frame.position.row(g) = d.position.row(Eigen::Index(j));
+        if (d.position_error.rows() > 0 && h.has_position_error) {
+          frame.position_error.row(g) = d.position_error.row(Eigen::Index(j));
+        }
         if (d.has_axis) {
           frame.axis.row(g) = d.axis.row(Eigen::Index(j));
           frame.hole_contact[k] = d.hole_contact[j];
+          if (!d.axis_error.empty() && h.has_axis_error) frame.axis_error[k] = d.axis_error[j];
         }
       }
     }

@@ -250,13 +250,15 @@ class GrainLocator {
       contact_radius.push_back(outer);
       // Physical units when the voxel size is known, voxels otherwise (vs = 1 then).
       d.add(f.sphere.centre, f.sphere.radius, quality(f), edge);
-      if (!d.has_axis || edge) continue;  // a cut grain's hole may be cut too: no axis
       const std::size_t row = d.size() - 1;
+      d.position_error.row(Eigen::Index(row)) = f.centre_sigma.transpose();
+      if (!d.has_axis || edge) continue;  // a cut grain's hole may be cut too: no axis
       if (o_.fit_axis) {
         // Seen when the fit pins it down: its standard error under the limit.
         if (!(f.axis_sigma <= o_.max_axis_sigma_degrees * kDegree)) continue;
         d.axis.row(Eigen::Index(row)) = f.sphere.axis.transpose();
         d.axis_quality[row] = 1 / (1 + f.axis_sigma / kDegree);
+        d.axis_error[row] = f.axis_sigma;
       } else {
         d.axis.row(Eigen::Index(row)) =
             lab_hole_axis(stack_, f.sphere.centre, radius_, vs_).transpose();

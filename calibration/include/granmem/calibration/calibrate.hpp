@@ -44,12 +44,17 @@ struct CalibrateOptions {
   // longest ending at the experiment's last cycle over which every observable fitted has
   // stopped changing within one packing's scatter.
   bool auto_window = false;
-  std::string noise = "auto";  // displacements: none, fit, auto, or a value in voxels
-  bool per_cycle = false;      // displacements: each cycle's CDF instead of the window's
-  double wall_distance = 0;    // m: grains closer to a container face are left out
+  // Displacements: none, fit, scans (the RMS of the position standard errors locate
+  // carried into the experiment's store), auto (fit for scans, none for simulations), or
+  // a value in voxels.
+  std::string noise = "auto";
+  bool per_cycle = false;    // displacements: each cycle's CDF instead of the window's
+  double wall_distance = 0;  // m: grains closer to a container face are left out
   // rad: steady state: the experiment's error in each hole axis (a scan's), added to the
   // twin's exact axes before their rotations are measured (cycle_observables.hpp); 0: none.
-  double axis_noise = 0;
+  // Unset (auto): the experiment's own, its scans' RMS axis standard error where its store
+  // has them (scan_errors.hpp), else none.
+  std::optional<double> axis_noise;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
   int degree = 2;              // of the polynomial in ln mu_s through the runs
   int replicas = 2;            // packings per friction (seeds seed, seed + 1, ...)
@@ -105,6 +110,10 @@ CalibrateSummary calibrate(const CalibrateOptions& options);
 // A list of frictions as the command line gives it ("0.05,0.1,0.2"), sorted; an Error
 // naming `option` if one is not a positive number or is listed twice.
 std::vector<double> parse_frictions(const std::string& text, const std::string& option);
+
+// --axis-noise's text: auto (unset: the experiment's own), or an angle in degrees (a bare
+// number or "deg"), returned in radians; an Error naming `option` otherwise.
+std::optional<double> parse_axis_noise(const std::string& text, const std::string& option);
 
 // Whether a `simulate` setting may be given to the twin: calibrate sets the runs' output,
 // cycles and mu_s itself, and the twin keeps no checkpoints, tracks or samples.

@@ -40,6 +40,9 @@ struct RunHeader {
   bool has_axis = false;          // cavity axes (unit, unsigned; NaN where unseen)
   bool has_orientation = false;   // full orientations (simulations)
   bool has_hole_contact = false;  // per-frame flag: grain touches a neighbour through its hole
+  // Per-frame standard errors of a scan's measurement (locate's fit covariance).
+  bool has_position_error = false;  // per axis, in length_unit
+  bool has_axis_error = false;      // of the cavity axis' direction, radians
   std::string creator_name = "granmem";
   std::string creator_version;
   std::string author;
@@ -57,6 +60,8 @@ struct Frame {
   Vectors3 axis;                           // N x 3 when the run has axes, else empty
   Quaternions orientation;                 // N x 4 when the run has orientations, else empty
   std::vector<std::uint8_t> hole_contact;  // N when the run has the flag, else empty
+  Vectors3 position_error;                 // N x 3 when the run has them; NaN where unknown
+  std::vector<double> axis_error;          // N when the run has them; NaN where unknown
 
   // A frame of `n` grains with every field the header declares, all unknown.
   static Frame unknown(const RunHeader& header);

@@ -13,10 +13,12 @@
 namespace granmem {
 
 // The grains found in one scan, a table with stable columns: frame, particle (the
-// detection's index), x, y, z, radius, quality, edge (1: cut by the stack's border), and,
-// where the cavity axis was looked for, ax, ay, az (unit, unsigned; NaN when not seen),
-// axis_quality, hole_contact (1: touches a neighbour through its hole). Lengths in
-// `length_unit` (voxel, or the unit of the voxel size).
+// detection's index), x, y, z, radius, quality, edge (1: cut by the stack's border), ep_x,
+// ep_y, ep_z (the centre's standard errors, trackpy's `ep`; NaN where unknown), and, where
+// the cavity axis was looked for, ax, ay, az (unit, unsigned; NaN when not seen),
+// axis_quality, axis_error (the axis' standard error, rad), hole_contact (1: touches a
+// neighbour through its hole). Lengths in `length_unit` (voxel, or the unit of the voxel
+// size). Tables without the standard errors (other programs', older files) read as NaN.
 struct Detections {
   std::int64_t frame = 0;  // scan index
   std::string length_unit = "voxel";
@@ -26,13 +28,14 @@ struct Detections {
   Vectors3 position;  // N x 3
   std::vector<double> radius, quality;
   std::vector<std::uint8_t> edge;
+  Vectors3 position_error;  // N x 3
   bool has_axis = false;
   Vectors3 axis;  // N x 3 when has_axis
-  std::vector<double> axis_quality;
+  std::vector<double> axis_quality, axis_error;
   std::vector<std::uint8_t> hole_contact;
 
   std::size_t size() const { return static_cast<std::size_t>(position.rows()); }
-  // Appends one detection (axis fields NaN/0 until set).
+  // Appends one detection (standard errors and axis fields NaN/0 until set).
   void add(const Eigen::Vector3d& x, double r, double q, bool on_edge);
 };
 

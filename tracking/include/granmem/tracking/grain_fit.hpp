@@ -34,6 +34,10 @@ struct GrainFit {
   // The fitted axis' standard error, radians (from the cost's curvature); NaN when the axis
   // was not fitted or the fit did not converge.
   double axis_sigma = std::numeric_limits<double>::quiet_NaN();
+  // The centre's standard error along x, y, z (the covariance's diagonal), in the window's
+  // length; NaN when the fit did not converge.
+  Eigen::Vector3d centre_sigma =
+      Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
 };
 
 struct GrainFitOptions {

@@ -45,9 +45,9 @@ void report(const char* what, const LocateScore& s) {
 // RMS standard error, and the hole axis' median angle error over the median its standard
 // error predicts (a tilt of sigma in each of two directions: a Rayleigh angle, median
 // 1.177 sigma). The axes' are their size (1.07-1.30 measured); the centres' run 1.8-3.1x
-// small, as the centres' errors are the model's mismatch more than the camera's noise
-// (on isolated grains without other artefacts 1.7-2.0x; with 4x the noise variance the
-// actual errors stay as they were): bounded so (docs/BENCHMARKS.md "Standard errors").
+// small, as the centres' errors are the model's misfit more than the camera's noise (with
+// 4x its variance they stay as they were, docs/BENCHMARKS.md "Standard errors"): bounded
+// so.
 void expect_standard_errors_to_scale(const LocateScore& s) {
   const Eigen::Array3d ratio = s.rms.array() / s.rms_standard_error.array();
   ASSERT_GT(s.axis_standard_error.size(), 50u);

@@ -167,10 +167,13 @@ FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const Run
   fit.per_cycle = o.per_cycle;
   if (o.noise == "scans") {
     *noise_model = o.noise;
-    if (!h.voxel_size || !errors.position.allFinite()) {
+    if (!errors.position.allFinite()) {
       throw Error(
           "--noise scans: the experiment's store has no position standard errors "
           "(tracked by granmem track from scans carries them)");
+    }
+    if (!h.voxel_size) {
+      throw Error("--noise scans: the experiment has no voxel size (the noise is in voxels)");
     }
     // sigma in voxels (the RMS over the axes), each axis' share in diameters.
     fit.noise_sigma = std::sqrt(errors.position.cwiseQuotient(*h.voxel_size).squaredNorm() / 3);

@@ -281,8 +281,8 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
        << "\nset logscale x\nset xlabel \"mu_s\"\nset key off\nset grid\n"
        << "set xrange [" << lowest << ":" << highest << "]\nset xtics "
        << design_tics(panels.front().run_mu_s) << "\n"
-       << "set object 1 rect from " << std::max(ci95[0], lowest) << ", graph 0 to "
-       << std::min(ci95[1], highest)
+       << "set object 1 rect from " << (ci95[0] > lowest ? ci95[0] : lowest) << ", graph 0 to "
+       << (ci95[1] < highest ? ci95[1] : highest)
        << ", graph 1 behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
        << "set arrow 1 from " << mu_s << ", graph 0 to " << mu_s
        << ", graph 1 nohead lw 2 lc rgb \"#b2182b\"\n";

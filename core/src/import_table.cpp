@@ -75,7 +75,8 @@ std::size_t index_of(const std::vector<std::int64_t>& sorted, std::int64_t value
 void check_dense_size(const Source& csv, std::size_t rows, std::size_t frames,
                       std::size_t particles) {
   const double slots = double(frames) * double(particles);
-  const double bytes = slots * (3 + 3 + 2) * sizeof(double);  // positions, axes, rows, flags
+  // positions, axes, standard errors (3 + 1), rows, flags
+  const double bytes = slots * (3 + 3 + 4 + 2) * sizeof(double);
   const double filled = double(rows) / slots;
   const std::string shape = std::to_string(rows) + " rows label " + std::to_string(frames) +
                             " frames x " + std::to_string(particles) + " particles";

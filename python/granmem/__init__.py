@@ -113,8 +113,8 @@ def _scans(detections):
     scans = []
     for k, df in enumerate(parts):
         frame = int(df["frame"].iloc[0]) if "frame" in df.columns and len(df) else k
-        columns = _columns(df, ["x", "y", "z", "radius", "quality", "edge", "ep_x", "ep_y",
-                                "ep_z", "ax", "ay", "az", "axis_quality", "axis_error",
+        columns = _columns(df, ["x", "y", "z", "radius", "quality", "edge", "ep", "ep_x",
+                                "ep_y", "ep_z", "ax", "ay", "az", "axis_quality", "axis_error",
                                 "hole_contact"])
         n = len(df)
         # trackpy's tables have no radius, quality or edge: unknown, good, inside.
@@ -345,7 +345,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
                               int(degree), int(replicas), int(refine),
-                              axis_noise if isinstance(axis_noise, str) else repr(float(axis_noise)),
+                              "auto" if axis_noise is None else axis_noise if isinstance(
+                                  axis_noise, str) else repr(float(axis_noise)),
                               deposit,
                               bool(fit_only),
                               int(parallel), twin, progress)

@@ -114,8 +114,9 @@ def test_the_author_set_is_recorded(tmp_path):
 
 
 def test_a_tracked_run_in_voxels_and_cycles_conforms(tmp_path, cli):
-    (tmp_path / "t.csv").write_text("frame,particle,x,y,z,ax,ay,az\n0,1,1,2,3,0,0,1\n"
-                                    "0,2,4,5,6,1,0,0\n1,1,1.5,2,3,0,0,1\n1,2,4,5,6.5,1,0,0\n")
+    (tmp_path / "t.csv").write_text("frame,particle,x,y,z,ax,ay,az,ep,axis_error\n"
+                                    "0,1,1,2,3,0,0,1,0.03,0.01\n0,2,4,5,6,1,0,0,0.02,0.02\n"
+                                    "1,1,1.5,2,3,0,0,1,0.03,0.01\n1,2,4,5,6.5,1,0,0,0.02,\n")
     cli("import", "t.csv", "--out", "run.h5", "--container", "0,0,0,10,10,10")
     check_conforms(tmp_path / "run.h5")
     with h5py.File(tmp_path / "run.h5", "r") as f:
@@ -124,6 +125,10 @@ def test_a_tracked_run_in_voxels_and_cycles_conforms(tmp_path, cli):
         assert "unit" not in position["value"].attrs and "unit" not in position["time"].attrs
         assert position["value"].attrs["granmem_unit"] == b"voxel"
         assert position["time"].attrs["granmem_unit"] == b"cycle"
+        # a scan's standard errors: positions' unit, and rad (an SI unit) for the axis'
+        assert f["particles/grains/position_error/value"].attrs["granmem_unit"] == b"voxel"
+        assert f["particles/grains/axis_error/value"].attrs["unit"] == b"rad"
+        assert f["particles/grains/axis_error/value"].shape == (2, 2)
     run = granmem.read_run(tmp_path / "run.h5")
     assert run["length_unit"] == "voxel" and run["time_unit"] == "cycle"
 

@@ -70,6 +70,13 @@ TEST_F(DetectionsFile, AnOlderTableWithoutStandardErrorsReadsThemAsUnknown) {
   EXPECT_TRUE(std::isnan(d.axis_error[0]));
 }
 
+TEST_F(DetectionsFile, TrackpysOneStaticErrorIsTheSameOnEachAxis) {
+  write_text(path("trackpy.csv"),
+             "frame,particle,x,y,z,radius,quality,edge,ep\n0,0,1,2,3,2.5,0.9,0,0.125\n");
+  const Detections d = read_detections(path("trackpy.csv"));
+  EXPECT_EQ(Eigen::Vector3d(d.position_error.row(0).transpose()), Eigen::Vector3d::Constant(0.125));
+}
+
 TEST_F(DetectionsFile, AFileWithoutDetectionsIsRefused) {
   write_text(path("other.csv"), "frame,particle,x,y\n0,0,1,2\n");
   EXPECT_THROW(read_detections(path("other.csv")), Error);

@@ -105,8 +105,11 @@ Detections from_table(const Table& t, const std::string& where) {
     d.add({t["x"].values[i], t["y"].values[i], t["z"].values[i]}, t["radius"].values[i],
           t["quality"].values[i], t["edge"].values[i] != 0);
     const auto r = Eigen::Index(i);
+    // trackpy's one `ep` stands for all three where the table has no ep_x, ep_y, ep_z.
     for (int a = 0; a < 3; ++a)
-      d.position_error(r, a) = value_or_nan(t, kPositionErrorColumns[a], i);
+      d.position_error(r, a) = t.has(kPositionErrorColumns[a])
+                                   ? t[kPositionErrorColumns[a]].values[i]
+                                   : value_or_nan(t, "ep", i);
     if (d.has_axis) {
       d.axis.row(r) << t["ax"].values[i], t["ay"].values[i], t["az"].values[i];
       d.axis_quality[i] = t["axis_quality"].values[i];
@@ -145,9 +148,10 @@ void write_detections(const Detections& d, const std::filesystem::path& path) {
 Detections read_detections(const std::filesystem::path& path) {
   const std::string where = path.string();
   if (path.extension() == ".csv") {
-    const CsvColumns c = read_csv(
-        path, {"frame", "particle", "x", "y", "z", "radius", "quality", "edge"},
-        {"ep_x", "ep_y", "ep_z", "ax", "ay", "az", "axis_quality", "axis_error", "hole_contact"});
+    const CsvColumns c =
+        read_csv(path, {"frame", "particle", "x", "y", "z", "radius", "quality", "edge"},
+                 {"ep", "ep_x", "ep_y", "ep_z", "ax", "ay", "az", "axis_quality", "axis_error",
+                  "hole_contact"});
     Detections d = from_table(c.table, where);
     d.source = where;
     // The unit is named in the header comment that write_detections() puts first.

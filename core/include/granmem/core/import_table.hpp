@@ -16,8 +16,9 @@ namespace granmem {
 // How to read a long-form table of tracked grains (trackpy, a lab's MATLAB code):
 // one row per grain per frame, columns frame,particle,x,y,z and optionally ax,ay,az
 // (cavity axis, any length, any sign), radius, hole_contact (0/1), a scan's standard
-// errors ep_x, ep_y, ep_z (or trackpy's one `ep`; the positions' unit) and axis_error
-// (rad), in any order.
+// errors ep_x, ep_y, ep_z (or trackpy's one `ep`; the positions' unit, scaled as they are)
+// and axis_error (rad, kept as given: with voxels of unequal sides, the angle in the
+// table's voxel space), in any order.
 struct ImportOptions {
   // Unit of x, y, z and radius in the table: m, cm, mm, um, or voxel.
   std::string length_unit = "voxel";

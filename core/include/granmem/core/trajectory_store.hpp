@@ -16,6 +16,8 @@
 //   /particles/grains/axis/...              [T,N,3] cavity axis, unsigned unit vector
 //   /particles/grains/orientation/...       [T,N,4] quaternion (w,x,y,z)
 //   /particles/grains/hole_contact/...      [T,N]   uint8 flag
+//   /particles/grains/position_error/...    [T,N,3] a scan's standard errors (length unit)
+//   /particles/grains/axis_error/...        [T,N]   a scan's axis standard error (rad)
 //   /particles/grains/{id,radius}[N], box/edges[3], box/offset[3]
 //   /observables/<name>/{value,step,time}
 //   /parameters/<producer>@<key>, /parameters/voxel_size[3]

@@ -18,7 +18,8 @@ namespace granmem {
 // the cavity axis was looked for, ax, ay, az (unit, unsigned; NaN when not seen),
 // axis_quality, axis_error (the axis' standard error, rad), hole_contact (1: touches a
 // neighbour through its hole). Lengths in `length_unit` (voxel, or the unit of the voxel
-// size). Tables without the standard errors (other programs', older files) read as NaN.
+// size). Tables without the standard errors (other programs', older files) read as NaN;
+// trackpy's one `ep` reads as the same error on each axis.
 struct Detections {
   std::int64_t frame = 0;  // scan index
   std::string length_unit = "voxel";

@@ -301,6 +301,14 @@ class Twin {
            << (o_.axis_noise ? "--axis-noise" : "the experiment's RMS axis standard error") << ")";
     }
     say(line.str());
+    // Axes from scans without their errors (another program's tracks): the twin's stay
+    // exact, and its rotations read small against the scans'; said, not guessed.
+    const RunHeader& h = experiment_.header();
+    if (observe.rotations && !o_.axis_noise && h.has_axis && !h.has_orientation &&
+        !h.has_axis_error && o_.observables == CalibrationObservables::steady_state) {
+      say("note: the experiment's hole axes carry no standard errors, so the twin's stay exact; "
+          "if they come from scans, give their error with --axis-noise DEG");
+    }
   }
 
   // Shared packings: one per seed (the design's, or `more`), kept in the output folder so

@@ -86,6 +86,14 @@ def test_the_axis_noise_is_read_from_the_scans_standard_errors(tmp_path, experim
     assert given["mu_s"] == pytest.approx(auto["mu_s"], rel=1e-6)
     none = granmem.calibrate(scans, tmp_path / "cal", **dict(FIT, axis_noise=0), **TWIN)
     assert none["mu_s"] != auto["mu_s"]
+    # Axes without their errors (another program's tracks): exact in the twin, and said.
+    bare = tmp_path / "bare.h5"
+    granmem.write_run(tracks.drop(columns=["qw", "qx", "qy", "qz", "axis_error"]), bare,
+                      length_unit="m")
+    lines = []
+    exact = granmem.calibrate(bare, tmp_path / "cal", progress=lines.append, **FIT, **TWIN)
+    assert exact["mu_s"] == none["mu_s"]
+    assert any("carry no standard errors" in r.get("line", "") for r in lines)
 
 
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):

@@ -50,7 +50,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--noise", args->noise,
                   "locating noise added to the simulated positions: none, fit, a value in voxels, "
                   "scans (the RMS of the position standard errors locate carried into the store), "
-                  "or auto (fit for scans, none for simulations)")
+                  "or auto (scans where the store has them, else fit for scans, none for "
+                  "simulations)")
       ->capture_default_str();
   cmd->add_option("--axis-noise", args->axis_noise,
                   "steady-state: the experiment's error in each hole axis, degrees (the "

@@ -157,17 +157,20 @@ void check_only(const CalibrateOptions& o, const SteadyState& measured) {
 }
 
 // The displacement fit's options; the locating noise from --noise and the experiment's
-// voxel. scans: the scans' own standard errors as the noise, not fitted (they run 2-3x
-// under the actual errors of a rendered scan, docs/CALIBRATION.md, so auto still fits).
+// voxel. scans (and auto where the store has them): the scans' own standard errors as the
+// noise, not fitted (a fitted noise is nearly degenerate with friction). A scan's position
+// error is 2-3x its standard error, but mostly shared by consecutive scans, so a
+// displacement's is 0.55-1.3x what the standard errors predict (docs/CALIBRATION.md).
 FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const RunHeader& h,
                                             const ScanErrors& errors, double diameter,
                                             std::string* noise_model) {
   FrictionFitOptions fit;
   fit.degree = o.degree;
   fit.per_cycle = o.per_cycle;
-  if (o.noise == "scans") {
-    *noise_model = o.noise;
-    if (!errors.position.allFinite()) {
+  const bool stored = errors.position.allFinite();
+  if (o.noise == "scans" || (o.noise == "auto" && stored && h.voxel_size)) {
+    *noise_model = "scans";
+    if (!stored) {
       throw Error(
           "--noise scans: the experiment's store has no position standard errors "
           "(tracked by granmem track from scans carries them)");

@@ -332,7 +332,8 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     every run. ``axis_noise`` (steady-state, degrees): the experiment's error in each hole
     axis (a scan's), added to the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
-    ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors.
+    ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors
+    ("auto" too where the store has them, else fits it on scans).
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``

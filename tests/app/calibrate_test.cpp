@@ -177,6 +177,15 @@ TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
   EXPECT_NE(json.find("\"noise_model\": \"scans\""), std::string::npos) << json;
   EXPECT_NEAR(json_value(json, "noise_sigma_voxel"), 0.5, 1e-12);
   EXPECT_EQ(json_value(json, "noise_sigma_error"), 0);  // given, not fitted
+  // auto takes them too where the store has them (the same runs, reused).
+  std::vector<std::string> automatic{"calibrate", "--experiment", "scans.h5",
+                                     "--out",     "cal",          "--window",
+                                     "1:3",       "--mu-s",       "0.05,0.1,0.2,0.4"};
+  automatic.insert(automatic.end(), kTwin.begin(), kTwin.end());
+  granmem_ok(automatic);
+  const std::string json_auto = read_text(in_work("cal/summary.json"));
+  EXPECT_NE(json_auto.find("\"noise_model\": \"scans\""), std::string::npos) << json_auto;
+  EXPECT_NEAR(json_value(json_auto, "noise_sigma_voxel"), 0.5, 1e-12);
   // A store without them: one clear error.
   expect_clean_failure(
       calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4", "--noise", "scans"}),

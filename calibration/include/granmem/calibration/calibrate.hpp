@@ -45,8 +45,8 @@ struct CalibrateOptions {
   // stopped changing within one packing's scatter.
   bool auto_window = false;
   // Displacements: none, fit, scans (the RMS of the position standard errors locate
-  // carried into the experiment's store), auto (fit for scans, none for simulations), or
-  // a value in voxels.
+  // carried into the experiment's store), auto (scans where the store has them, else fit
+  // for scans, none for simulations), or a value in voxels.
   std::string noise = "auto";
   bool per_cycle = false;    // displacements: each cycle's CDF instead of the window's
   double wall_distance = 0;  // m: grains closer to a container face are left out

@@ -1,0 +1,41 @@
+"""Tracked scans against the DEM run they were rendered from (a pseudo-experiment): each
+scan's position error, the error of each end-of-cycle displacement, how much the errors of
+consecutive scans share, and what locate's stored standard errors predict.
+Usage: scripts/scan_errors_against_truth.py TRACKS.h5 DEM.h5   (PYTHONPATH=build/python)"""
+import sys
+import numpy as np
+from scipy.spatial import cKDTree
+import granmem
+
+trk, dem = granmem.read_run(sys.argv[1]), granmem.read_run(sys.argv[2])
+d = 2 * np.nanmedian(dem["radius"])
+vox = np.asarray(trk["voxel_size"])
+steps = list(trk["step"])
+def frame(run, step): return run["position"][list(run["step"]).index(step)]
+t0 = frame(trk, steps[0])
+seen = np.all(np.isfinite(t0), axis=1)
+dist, idx = cKDTree(frame(dem, steps[0])).query(np.where(seen[:, None], t0, 1e9))
+ok = seen & (dist < 0.2 * d)
+def errors(s):  # each tracked grain's position less its DEM grain's, common offset removed
+    e = frame(trk, s) - frame(dem, s)[idx]
+    m = ok & np.all(np.isfinite(e), 1)
+    return e - np.median(e[m], 0), m
+pos, disp, pred, corr = [], [], [], []
+sigma = lambda s: trk["position_error"][steps.index(s)] / vox
+for a, b in zip(steps[:-1], steps[1:]):
+    ea, ma = errors(a)
+    eb, mb = errors(b)
+    m = ma & mb
+    disp.append((eb - ea)[m] / vox)
+    pred.append(np.sqrt(sigma(a)[m] ** 2 + sigma(b)[m] ** 2))
+    corr.append([np.corrcoef(ea[m, k], eb[m, k])[0, 1] for k in range(3)])
+for s in steps:
+    e, m = errors(s)
+    pos.append(e[m] / vox)
+rms = lambda x: np.sqrt(np.mean(np.vstack(x) ** 2, 0))
+print(f"{sys.argv[1]}: {ok.sum()} grains matched, scans {steps[0]}-{steps[-1]}; voxels, x y z")
+print("position error RMS              ", rms(pos).round(4))
+print("its standard error RMS          ", rms([sigma(s)[ok] for s in steps]).round(4))
+print("displacement error RMS          ", rms(disp).round(4))
+print("predicted, sqrt(s_a^2 + s_b^2)  ", rms(pred).round(4))
+print("consecutive scans' errors, corr.", np.mean(corr, 0).round(3))

@@ -12,7 +12,7 @@ ScanErrors scan_errors(const TrajectoryReader& run) {
   double axis_squares = 0;
   for (std::size_t t = 0; t < run.frame_count(); ++t) {
     const Frame f = run.read_frame(t);
-    for (Eigen::Index i = 0; h.has_position_error && i < f.position_error.rows(); ++i) {
+    for (Eigen::Index i = 0; i < f.position_error.rows(); ++i) {
       const Eigen::Vector3d sigma = f.position_error.row(i).transpose();
       if (!sigma.allFinite()) continue;
       position_squares += sigma.cwiseAbs2();

@@ -16,9 +16,9 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 const char* const kAxisColumns[] = {"ax", "ay", "az", "axis_quality", "hole_contact"};
 const char* const kPositionErrorColumns[] = {"ep_x", "ep_y", "ep_z"};
 
-// A column's value in row i, NaN when the table has no such column.
-double value_or_nan(const Table& t, const char* column, std::size_t i) {
-  return t.has(column) ? t[column].values[i] : kNaN;
+// A column's values, or none where the table has no such column.
+const std::vector<double>* values_of(const Table& t, const char* column) {
+  return t.has(column) ? &t[column].values : nullptr;
 }
 
 }  // namespace
@@ -101,19 +101,24 @@ Detections from_table(const Table& t, const std::string& where) {
       if (!t.has(c)) throw Error(where + ": detections with an axis lack the column '" + c + "'");
     }
   }
+  // The standard errors where the table has them: trackpy's one `ep` stands for all three
+  // where it has no ep_x, ep_y, ep_z.
+  const std::vector<double>* ep[3];
+  for (int a = 0; a < 3; ++a) {
+    ep[a] = values_of(t, kPositionErrorColumns[a]);
+    if (!ep[a]) ep[a] = values_of(t, "ep");
+  }
+  const std::vector<double>* axis_error = values_of(t, "axis_error");
   for (std::size_t i = 0; i < t.rows(); ++i) {
     d.add({t["x"].values[i], t["y"].values[i], t["z"].values[i]}, t["radius"].values[i],
           t["quality"].values[i], t["edge"].values[i] != 0);
     const auto r = Eigen::Index(i);
-    // trackpy's one `ep` stands for all three where the table has no ep_x, ep_y, ep_z.
     for (int a = 0; a < 3; ++a)
-      d.position_error(r, a) = t.has(kPositionErrorColumns[a])
-                                   ? t[kPositionErrorColumns[a]].values[i]
-                                   : value_or_nan(t, "ep", i);
+      d.position_error(r, a) = ep[a] ? (*ep[a])[i] : kNaN;
     if (d.has_axis) {
       d.axis.row(r) << t["ax"].values[i], t["ay"].values[i], t["az"].values[i];
       d.axis_quality[i] = t["axis_quality"].values[i];
-      d.axis_error[i] = value_or_nan(t, "axis_error", i);
+      d.axis_error[i] = axis_error ? (*axis_error)[i] : kNaN;
       d.hole_contact[i] = t["hole_contact"].values[i] != 0;
     }
   }

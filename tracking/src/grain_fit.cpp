@@ -110,7 +110,7 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
       summary.status != ceres::TinySolver<GrainResiduals<kParameters>>::HIT_MAX_ITERATIONS &&
       x.allFinite();
   fit.rms = std::sqrt(2 * summary.final_cost / std::max<double>(1, double(window.points.size())));
-  if (!fit.converged) return fit;
+  if (!fit.converged || !options.standard_errors) return fit;
   const auto covariance = parameter_covariance(f, x);
   if (!covariance) return fit;
   fit.centre_sigma = covariance->diagonal().template head<3>().cwiseMax(0).cwiseSqrt();

@@ -383,7 +383,9 @@ class GrainLocator {
       // centre first: a sphere without hole fitted from the candidate gives it.
       HoledSphere plain = s;
       plain.hole = 0;
-      const GrainFit sphere = fit_grain(window, plain, fo);
+      GrainFitOptions start = fo;
+      start.standard_errors = false;
+      const GrainFit sphere = fit_grain(window, plain, start);
       if (sphere.converged && (sphere.sphere.centre - s.centre).norm() < 0.5 * s.radius) {
         from.centre = sphere.sphere.centre;
       }

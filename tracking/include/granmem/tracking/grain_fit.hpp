@@ -41,7 +41,8 @@ struct GrainFit {
 };
 
 struct GrainFitOptions {
-  bool fit_axis = true;  // with a hole: also the axis
+  bool fit_axis = true;         // with a hole: also the axis
+  bool standard_errors = true;  // centre_sigma and axis_sigma (a fit that only starts another: no)
   int max_iterations = 40;
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -134,9 +135,11 @@ ObservableOptions observable_options(const CalibrateOptions& o, const Trajectory
 
 // The experiment's observables, measured in its own container, open at the top as the
 // twin's: the lid moves, so grains are left out near the floor and the side walls only.
-CycleObservables measured_observables(const TrajectoryReader& experiment, ObservableOptions o) {
+// `extra_axis_noise`: rad, the experiment's axes tilted once more (its axes carry their own).
+CycleObservables measured_observables(const TrajectoryReader& experiment, ObservableOptions o,
+                                      double extra_axis_noise = 0) {
   o.motion.box.reset();
-  o.axis_noise = 0;  // the experiment's axes carry their own
+  o.axis_noise = extra_axis_noise;
   if (const auto& box = experiment.header().box; box && o.motion.wall_distance > 0) {
     o.motion.box = Box{box->lower, Eigen::Vector3d(box->edges(0), box->edges(1), 1e9)};
   }
@@ -258,14 +261,19 @@ class Twin {
     return line.str();
   }
 
-  // The experiment's steady state. Grains known to be alike (the twin's are, without
-  // polydispersity) are measured at the twin's radius: a scan's located radii come out
-  // ~5 % small from its blur and threshold, which would read as a packing 15 % looser and
-  // with no contacts.
+  // The experiment's steady state, measured with what the twin knows of its grains. Grains
+  // known to be alike (the twin's are, without polydispersity) at the twin's radius: a
+  // scan's located radii come out ~5 % small from its blur and threshold, which would read
+  // as a packing 15 % looser and with no contacts. The packing's height with the twin's
+  // grain count, the experiment's own: grains a scan misses would read as a looser packing.
   SteadyState measured_steady_state() const {
-    std::optional<double> radius;
-    if (deposit_.polydispersity == 0) radius = deposit_.radius;
-    return steady_state(experiment_, measured, {}, radius);
+    return steady_state(experiment_, measured, {}, known_grains());
+  }
+  KnownGrains known_grains() const {
+    KnownGrains known;
+    if (deposit_.polydispersity == 0) known.radius = deposit_.radius;
+    known.count = std::size_t(deposit_.grains);
+    return known;
   }
 
   const CalibrateOptions& options() const { return o_; }
@@ -287,6 +295,7 @@ class Twin {
 
   void announce() const {
     note_experiment_seed();
+    note_located_grains();
     std::ostringstream line;
     std::string mu;
     for (double m : sorted(o_.mu_s))
@@ -312,6 +321,34 @@ class Twin {
       say("note: the experiment's hole axes carry no standard errors, so the twin's stay exact; "
           "if they come from scans, give their error with --axis-noise DEG");
     }
+  }
+
+  // The experiment's frames locate fewer (or more) grains than the twin pours: a few
+  // missed by the scans are counted in its height; many mean the twin is not its packing.
+  void note_located_grains() const {
+    std::size_t fewest = std::numeric_limits<std::size_t>::max(), most = 0;
+    for (std::size_t t = 0; t < experiment_.frame_count(); ++t) {
+      const Vectors3 x = experiment_.read_frame(t).position;
+      std::size_t located = 0;
+      for (Eigen::Index i = 0; i < x.rows(); ++i)
+        located += x.row(i).allFinite();
+      fewest = std::min(fewest, located);
+      most = std::max(most, located);
+    }
+    const auto n = std::size_t(deposit_.grains);
+    if (fewest == n && most == n) return;
+    std::ostringstream line;
+    line << "note: the experiment's frames locate " << fewest;
+    if (most != fewest) line << "-" << most;
+    line << " grains, the twin pours " << n;
+    if (std::max(n - std::min(n, fewest), most - std::min(most, n)) > n / 20) {
+      line << ": more than 5 % apart, so the twin is not the experiment's packing; give it "
+              "the experiment's grain count ([simulate] grains)";
+    } else {
+      line << ": its packing's height is taken with " << n << " grains ("
+           << (fewest < n ? "the scans missed some" : "the scans split some") << ")";
+    }
+    say(line.str());
   }
 
   // Shared packings: one per seed (the design's, or `more`), kept in the output folder so
@@ -566,17 +603,102 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
   return fo;
 }
 
-ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs) {
-  const CalibrateOptions& o = twin.options();
-  return fit_friction_to_steady_state(twin.measured_steady_state(), runs, observable_fit_options(o),
-                                      o.only);
+// An observable from positions that the scans' own locating noise moves by more than
+// kNoiseShare of one packing's scatter: the twin's positions are exact, so it would pull
+// the fit by the scans' noise, not by friction (a contact count within a 2 % gap, at a
+// locating error of 1 % of a diameter). Measured by moving the experiment's positions by
+// their own RMS standard error once more; as a scan's position error is 2-3x its standard
+// error (docs/BENCHMARKS.md), the share is small. The rotation likewise, by tilting its
+// axes once more; the twin's axes get the same noise, but its size is known to ~10 %
+// (docs/BENCHMARKS.md), so a rotation the noise dominates is modelled to only ~20 % of the
+// noise's part: kModelledNoise of the effect is what may bias the fit.
+constexpr double kNoiseShare = 0.25;
+constexpr double kModelledNoise = 0.2;
+struct NoiseLimited {
+  std::string name;
+  double effect, scatter;
+  bool modelled;  // the twin adds the same noise (the axes')
+};
+
+std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
+                                        const std::vector<double>& scatter) {
+  SteadyState effect;
+  const Eigen::Vector3d e = twin.errors.position;
+  if (e.allFinite() && !e.isZero()) {
+    effect = structure_noise_effect(twin.experiment(), twin.observe.window,
+                                    std::sqrt(e.squaredNorm() / 3), {}, twin.known_grains());
+  }
+  double rotation = std::nan("");
+  if (twin.errors.axis > 0 && twin.observe.rotations) {
+    const CycleObservables tilted =
+        measured_observables(twin.experiment(), twin.observe, twin.errors.axis);
+    const KnownGrains& known = twin.known_grains();
+    rotation = steady_state(twin.experiment(), tilted, {}, known)["rot_disp"] -
+               twin.measured_steady_state()["rot_disp"];
+  }
+  std::vector<NoiseLimited> limited;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const bool modelled = names[k] == "rot_disp";
+    const double d = modelled ? rotation : effect[names[k]];
+    if (std::isfinite(d) &&
+        (modelled ? kModelledNoise : 1) * std::abs(d) > kNoiseShare * scatter[k])
+      limited.push_back({names[k], d, scatter[k], modelled});
+  }
+  return limited;
 }
 
-JointObservableFit joint_steady_state_fit(const Twin& twin,
-                                          const std::vector<SteadyStateRun>& runs) {
+// The fit again without the observables the scans' noise moves, unless they were chosen
+// with --only; `fewest`: the observables the fit needs.
+template <class Fit, class Refit>
+Fit without_noise_limited(const Twin& twin, Fit fit, Refit refit, std::size_t fewest,
+                          std::vector<NoiseLimited>* left_out) {
+  if (!twin.options().only.empty()) return fit;
+  const std::vector<NoiseLimited> limited = noise_limited(twin, fit.names, fit.scatter);
+  std::vector<std::string> kept;
+  for (const std::string& name : fit.names) {
+    if (std::none_of(limited.begin(), limited.end(),
+                     [&](const NoiseLimited& l) { return l.name == name; }))
+      kept.push_back(name);
+  }
+  if (limited.empty() || kept.size() < fewest) return fit;
+  if (left_out) *left_out = limited;
+  return refit(kept);
+}
+
+ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+                               std::vector<NoiseLimited>* left_out = nullptr) {
   const CalibrateOptions& o = twin.options();
-  return fit_frictions_to_steady_state(twin.measured_steady_state(), runs,
-                                       observable_fit_options(o), o.only);
+  auto fit = [&](const std::vector<std::string>& names) {
+    return fit_friction_to_steady_state(twin.measured_steady_state(), runs,
+                                        observable_fit_options(o), names);
+  };
+  return without_noise_limited(twin, fit(o.only), fit, 1, left_out);
+}
+
+JointObservableFit joint_steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+                                          std::vector<NoiseLimited>* left_out = nullptr) {
+  const CalibrateOptions& o = twin.options();
+  auto fit = [&](const std::vector<std::string>& names) {
+    return fit_frictions_to_steady_state(twin.measured_steady_state(), runs,
+                                         observable_fit_options(o), names);
+  };
+  return without_noise_limited(twin, fit(o.only), fit, 2, left_out);
+}
+
+// The report's lines on the observables left out, and why; their names for summary.json.
+void report_noise_limited(const std::vector<NoiseLimited>& limited, std::ostream& report,
+                          JsonObject& j) {
+  std::vector<std::string> names;
+  for (const NoiseLimited& l : limited) {
+    report << std::setprecision(3) << "  note: " << l.name << " left out: the scans' own "
+           << (l.modelled ? "axis" : "locating") << " noise moves it by " << l.effect
+           << " (one packing's scatter " << l.scatter << ")"
+           << (l.modelled ? ", more than the twin's tilted axes model"
+                          : " and the twin's positions are exact")
+           << " (--only keeps it)\n";
+    names.push_back(l.name);
+  }
+  j["left_out_for_locating_noise"] = names;
 }
 
 // Strictly inside the range of `simulated`.
@@ -640,7 +762,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
   const SteadyState measured = twin.measured_steady_state();
-  const ObservableFit fit = steady_state_fit(twin, runs);
+  std::vector<NoiseLimited> limited;
+  const ObservableFit fit = steady_state_fit(twin, runs, &limited);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed()};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
@@ -675,6 +798,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["mu_s_simulated"] = simulated;
   j["refine"] = o.refine;
   j["observables"] = written.observables;
+  std::ostringstream left_out;
+  report_noise_limited(limited, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -684,6 +809,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
          << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
          << " in ln mu_s on " << fit.cross_validations << " runs\n";
+  report << left_out.str();
   for (const std::string& note : written.notes)
     report << "  note: " << note << "\n";
   report << "wrote " << (o.out / "summary.json").string() << ", steady_state_runs.csv, "
@@ -694,7 +820,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
                std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
-  const JointObservableFit fit = joint_steady_state_fit(twin, runs);
+  std::vector<NoiseLimited> limited;
+  const JointObservableFit fit = joint_steady_state_fit(twin, runs, &limited);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
@@ -734,6 +861,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   j["n_simulations"] = s.simulations;
   j["replicas"] = o.replicas;
   j["observables"] = fit.names;
+  std::ostringstream left_out;
+  report_noise_limited(limited, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -748,7 +877,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
          << fit.dof << " dof; cross-validated " << fit.cross_validated_sigma[0] << " (mu_s), "
          << fit.cross_validated_sigma[1] << " (mu_r) in ln on " << fit.cross_validations
          << " runs\n"
-         << "wrote " << (o.out / "summary.json").string() << ", "
+         << left_out.str() << "wrote " << (o.out / "summary.json").string() << ", "
          << figure.size() + compared.written.size() << " figure files\n";
 }
 

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/random.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/units.hpp"
 
@@ -217,17 +218,17 @@ std::string steady_state_label(const std::string& name) {
   return it == labels.end() ? name : it->second;
 }
 
-ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
-                                   const StructureOptions& structure,
-                                   std::optional<double> grain_radius, CycleRange cycles) {
+namespace {
+
+// The observables from positions, frame by frame, each position moved by a normal error of
+// `jitter` per axis (the run's length unit; 0: as stored).
+void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
+                          const StructureOptions& structure, const KnownGrains& known,
+                          CycleRange cycles, double jitter = 0, std::uint64_t seed = 1) {
   const auto in_range = [&](std::int64_t c) {
     return cycles.second == 0 || (c >= cycles.first && c <= cycles.second);
   };
-  ObservableSeries s;
-  if (std::any_of(observed.mean_rot_disp.begin(), observed.mean_rot_disp.end(),
-                  [](double v) { return std::isfinite(v); })) {
-    s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
-  }
+  Random random(seed);
   ObservableSeries::Entry packing{"bulk_packing_fraction", {}, {}, true},
       coordination{"coordination", {}, {}, true},
       from_height{"height_packing_fraction", {}, {}, true};
@@ -235,22 +236,39 @@ ObservableSeries observable_series(const TrajectoryReader& run, const CycleObser
   const auto& h = run.header();
   const double section = h.box ? h.box->edges(0) * h.box->edges(1) : kNaN;
   const std::vector<double> radius =
-      grain_radius ? std::vector<double>(h.id.size(), *grain_radius / metres_per_length(run))
+      known.radius ? std::vector<double>(h.id.size(), *known.radius / metres_per_length(run))
                    : h.radius;
   for (std::size_t t = 0; t < run.frame_count(); ++t) {
     const std::int64_t c = run.steps()[t];
     if (!in_range(c)) continue;
-    const Vectors3 position = run.read_frame(t).position;
+    Vectors3 position = run.read_frame(t).position;
+    if (jitter > 0) {
+      for (Eigen::Index i = 0; i < position.rows(); ++i)
+        position.row(i) += jitter * normal_vector(random).transpose();
+    }
     const PackingStructure p = packing_structure(position, radius, structure);
     for (auto* e : {&packing, &coordination, &from_height})
       e->cycle.push_back(c);
     packing.value.push_back(p.packing_fraction);
     coordination.value.push_back(p.coordination);
-    from_height.value.push_back(height_packing_fraction(position, radius, section));
+    from_height.value.push_back(height_packing_fraction(position, radius, section, known.count));
   }
   s.entries.push_back(std::move(packing));
   s.entries.push_back(std::move(coordination));
   if (h.box) s.entries.push_back(std::move(from_height));
+}
+
+}  // namespace
+
+ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
+                                   const StructureOptions& structure, const KnownGrains& known,
+                                   CycleRange cycles) {
+  ObservableSeries s;
+  if (std::any_of(observed.mean_rot_disp.begin(), observed.mean_rot_disp.end(),
+                  [](double v) { return std::isfinite(v); })) {
+    s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
+  }
+  add_structure_series(s, run, structure, known, cycles);
   for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
     const auto it = run.observables().find(name);
     if (it != run.observables().end()) {
@@ -290,9 +308,23 @@ SteadyState window_means(const ObservableSeries& series, CycleRange window) {
   return s;
 }
 
+SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window, double sigma,
+                                   const StructureOptions& structure, const KnownGrains& known,
+                                   std::uint64_t seed) {
+  ObservableSeries plain, jittered;
+  add_structure_series(plain, run, structure, known, window);
+  add_structure_series(jittered, run, structure, known, window, sigma, seed);
+  SteadyState effect = window_means(jittered, window);
+  const SteadyState as_measured = window_means(plain, window);
+  for (std::size_t k = 0; k < effect.values.size(); ++k)
+    effect.values[k] -= as_measured.values[k];
+  effect.drift.clear();
+  return effect;
+}
+
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure, std::optional<double> grain_radius) {
-  return window_means(observable_series(run, observed, structure, grain_radius, observed.window),
+                         const StructureOptions& structure, const KnownGrains& known) {
+  return window_means(observable_series(run, observed, structure, known, observed.window),
                       observed.window);
 }
 

@@ -96,6 +96,42 @@ def test_the_axis_noise_is_read_from_the_scans_standard_errors(tmp_path, experim
     assert any("carry no standard errors" in r.get("line", "") for r in lines)
 
 
+def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experiment):
+    # The pseudo-experiment as scans locating centres to 0.1 mm (2 % of a diameter, said
+    # by their standard errors), imported in the container's frame. The height of 60 grains
+    # is a few grains' tops and bottoms, which such noise moves (the highest of a few noisy
+    # tops is higher) by most of one packing's scatter: the twin, exact, would not see it.
+    tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
+    lo, hi = granmem.read_run(experiment)["box"]
+    rng = np.random.default_rng(3)
+
+    def scans(sigma, name, missed=()):
+        located = tracks.copy()
+        for c in ("x", "y", "z"):
+            located[c] += rng.normal(0, sigma, len(located))
+            located["ep_" + c] = sigma
+        located.drop(index=list(missed)).to_csv(tmp_path / (name + ".csv"), index=False)
+        cli("import", name + ".csv", "--out", name + ".h5", "--length-unit", "m",
+            "--container", ",".join(str(v) for v in (*lo, *hi)))
+        return tmp_path / (name + ".h5")
+
+    lines = []
+    noisy = granmem.calibrate(scans(1e-4, "noisy", missed=[5]), tmp_path / "cal",
+                              progress=lines.append, **FIT, **TWIN)
+    summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
+    assert summary["left_out_for_locating_noise"] == ["height_packing_fraction"]
+    assert list(summary["observables"]) == ["rot_disp"]
+    assert "height_packing_fraction left out: the scans' own locating noise moves it by" \
+        in noisy["report"]
+    assert any("locate 59-60 grains, the twin pours 60" in r.get("line", "") for r in lines)
+    # located to 1 um, the same packing keeps it; and --only keeps it whatever the noise
+    sharp = granmem.calibrate(scans(1e-6, "sharp"), tmp_path / "cal", **FIT, **TWIN)
+    assert "left out" not in sharp["report"]
+    only = dict(FIT, only=["rot_disp", "height_packing_fraction"])
+    kept = granmem.calibrate(tmp_path / "noisy.h5", tmp_path / "cal", **only, **TWIN)
+    assert "left out" not in kept["report"]
+
+
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):
     def stop_at_first_report(report):
         if "cycle" in report:

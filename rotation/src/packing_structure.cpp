@@ -105,20 +105,23 @@ PackingStructure packing_structure(const Vectors3& position, const std::vector<d
 }
 
 double height_packing_fraction(const Vectors3& position, const std::vector<double>& radius,
-                               double cross_section) {
+                               double cross_section, std::optional<std::size_t> grains) {
   std::vector<double> known;
   for (double r : radius)
     if (std::isfinite(r)) known.push_back(r);
   if (known.empty() || !(cross_section > 0)) return std::nan("");
   const double typical = median(known);
   double bottom = std::numeric_limits<double>::infinity(), top = -bottom, volume = 0;
+  std::size_t located = 0;
   for (Eigen::Index i = 0; i < position.rows() && std::size_t(i) < radius.size(); ++i) {
     if (!position.row(i).allFinite()) continue;
     const double r = std::isfinite(radius[std::size_t(i)]) ? radius[std::size_t(i)] : typical;
     bottom = std::min(bottom, position(i, 2) - r);
     top = std::max(top, position(i, 2) + r);
     volume += 4.0 / 3.0 * M_PI * r * r * r;
+    ++located;
   }
+  if (grains && located > 0) volume *= double(*grains) / double(located);
   return top > bottom ? volume / (cross_section * (top - bottom)) : std::nan("");
 }
 

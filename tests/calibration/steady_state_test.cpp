@@ -115,11 +115,55 @@ TEST_F(SteadyStateTest, TheStructureIsMeasuredAtTheGrainsKnownRadiusWhenGiven) {
   EXPECT_NEAR(at_located["height_packing_fraction"],
               512 * 4.0 / 3 * M_PI * std::pow(0.475, 3) / (64 * 7.95), 1e-12);
   EXPECT_DOUBLE_EQ(at_located["coordination"], 0);  // 5 % gaps: no grain touches
-  const SteadyState at_known = steady_state(run, observed, {}, 0.5e-3);  // m
+  const SteadyState at_known = steady_state(run, observed, {}, {0.5e-3, {}});  // m
   EXPECT_NEAR(at_known["bulk_packing_fraction"], M_PI / 6, 1e-12);
   EXPECT_DOUBLE_EQ(at_known["coordination"], 6);
   EXPECT_NEAR(at_known["height_packing_fraction"], M_PI / 6, 1e-12);
   EXPECT_NEAR(at_known["rot_disp"], kTurn / 2, 1e-12);  // rotations do not use the radius
+}
+
+// A scan misses grains (dim, blurred): each one lowers the packing fraction from the height
+// by 1/N; with the count the packing holds it is the whole packing's again. The lowest and
+// highest layers are kept, so the height is the packing's.
+TEST_F(SteadyStateTest, GrainsAScanMissedAreCountedInThePackingsHeight) {
+  Trajectories scan = cubic_run();
+  const std::size_t n = scan.header.id.size();
+  std::size_t missed = 0;
+  for (Frame& f : scan.frames) {
+    for (std::size_t i = 64; i < n - 64; i += 37, ++missed)  // not in the first or last layer
+      f.position.row(Eigen::Index(i)).setConstant(std::nan(""));
+  }
+  missed /= scan.frames.size();
+  write_trajectories(path("scan.h5"), scan);
+  const TrajectoryReader run(path("scan.h5"));
+  ObservableOptions o;
+  o.window = {3, 4};
+  const CycleObservables observed = cycle_observables(run, o);
+  const double lattice = M_PI / 6;  // 8 layers of touching grains, 8 mm high
+  EXPECT_NEAR(steady_state(run, observed)["height_packing_fraction"],
+              lattice * double(n - missed) / double(n), 1e-12);
+  EXPECT_NEAR(steady_state(run, observed, {}, {{}, n})["height_packing_fraction"], lattice, 1e-12);
+}
+
+// Locating noise opens touching pairs: on the lattice of touching grains a contact count
+// within a 2 % gap falls as soon as the noise is a fraction of that gap, while the height's
+// packing fraction hardly moves (its ends are many grains). No noise, no effect; the same
+// seed, the same effect.
+TEST_F(SteadyStateTest, LocatingNoiseOpensContactsButKeepsThePackingsHeight) {
+  write_trajectories(path("run.h5"), cubic_run());
+  const TrajectoryReader run(path("run.h5"));
+  const CycleRange window{3, 4};
+  const SteadyState none = structure_noise_effect(run, window, 0);
+  for (double v : none.values)
+    EXPECT_EQ(v, 0);
+  const SteadyState noisy = structure_noise_effect(run, window, 0.01);  // mm: 1 % of d
+  // A bond stays within the 2 % gap while its gap, ~normal with sigma sqrt(2) x 1 %, is
+  // below 0.02 d: ~92 % of them, of ~5 bonds a grain in this small lattice.
+  EXPECT_LT(noisy["coordination"], -0.2);
+  EXPECT_GT(noisy["coordination"], -0.7);
+  EXPECT_LT(std::abs(noisy["height_packing_fraction"]), 0.005);
+  EXPECT_TRUE(std::isnan(noisy["rot_disp"]));  // not from positions
+  EXPECT_EQ(structure_noise_effect(run, window, 0.01).values, noisy.values);
 }
 
 // compare's options (the window and wall distance it pools these observables with),

@@ -97,12 +97,18 @@ struct SteadyState {
   double operator[](const std::string& name) const;
   double drift_of(const std::string& name) const;
 };
-// `grain_radius` (m): measure the structure with every grain at this radius instead of the
-// store's radii (a scan's located radii are biased by its blur and threshold, and a packing
-// fraction goes as r^3).
+// What is known of a packing's grains beyond what a scan locates.
+struct KnownGrains {
+  // m: every grain's radius, for grains known to be alike; the structure is measured at it
+  // instead of the store's radii (a scan's located radii are biased by its blur and
+  // threshold, and a packing fraction goes as r^3).
+  std::optional<double> radius;
+  // How many grains the packing holds: a scan that misses some (dim, blurred, at the far
+  // side of the beam) would read a looser packing from its height, 1/N per grain missed.
+  std::optional<std::size_t> count;
+};
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure = {},
-                         std::optional<double> grain_radius = {});
+                         const StructureOptions& structure = {}, const KnownGrains& known = {});
 
 // Cycles, inclusive; (0, 0): every cycle.
 using CycleRange = std::pair<std::int64_t, std::int64_t>;
@@ -120,9 +126,16 @@ struct ObservableSeries {
 };
 ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
                                    const StructureOptions& structure = {},
-                                   std::optional<double> grain_radius = {},
-                                   CycleRange cycles = {0, 0});
+                                   const KnownGrains& known = {}, CycleRange cycles = {0, 0});
 SteadyState window_means(const ObservableSeries& series, CycleRange window);
+// How far locating noise moves the observables from positions (bulk and height packing
+// fractions, coordination): their window means with every position moved by a further
+// normal error of `sigma` per axis (the run's length unit), minus as measured. On a scan,
+// with sigma its own standard error, what its noise has already done to them: a contact
+// count within a small gap, for one, falls as noise opens touching pairs. No drift.
+SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window, double sigma,
+                                   const StructureOptions& structure = {},
+                                   const KnownGrains& known = {}, std::uint64_t seed = 1);
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at
 // full compression (N)"); the name itself for one it does not know.
 std::string steady_state_label(const std::string& name);

@@ -41,9 +41,11 @@ PackingStructure packing_structure(const Vectors3& position, const std::vector<d
 // container's cross-section (`cross_section`, m^2 or the positions' unit squared) times
 // the height from the lowest grain's bottom to the highest grain's top, which is where
 // the floor and a free lid are. From positions alone, so a scan measures it as the DEM's
-// lid does, without registering the scan to the container's floor. NaN without grains
-// or cross-section.
+// lid does, without registering the scan to the container's floor. With `grains`, the
+// count the packing is known to hold, the located grains' volume is scaled to it (a scan
+// that missed some grains still sees the packing's height). NaN without grains or
+// cross-section.
 double height_packing_fraction(const Vectors3& position, const std::vector<double>& radius,
-                               double cross_section);
+                               double cross_section, std::optional<std::size_t> grains = {});
 
 }  // namespace granmem

@@ -609,9 +609,10 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
 // locating error of 1 % of a diameter). Measured by moving the experiment's positions by
 // their own RMS standard error once more; as a scan's position error is 2-3x its standard
 // error (docs/BENCHMARKS.md), the share is small. The rotation likewise, by tilting its
-// axes once more; the twin's axes get the same noise, but its size is known to ~10 %
-// (docs/BENCHMARKS.md), so a rotation the noise dominates is modelled to only ~20 % of the
-// noise's part: kModelledNoise of the effect is what may bias the fit.
+// axes once more, but the twin's axes get the same noise: only its size's error, ~10 %
+// (docs/BENCHMARKS.md), so ~20 % of the noise's part (kModelledNoise), can bias the fit,
+// and the rotation is left out where that could exceed one packing's scatter (the noise
+// then most of what is measured).
 constexpr double kNoiseShare = 0.25;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
@@ -632,7 +633,7 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   if (twin.errors.axis > 0 && twin.observe.rotations) {
     const CycleObservables tilted =
         measured_observables(twin.experiment(), twin.observe, twin.errors.axis);
-    const KnownGrains& known = twin.known_grains();
+    const KnownGrains known = twin.known_grains();
     rotation = steady_state(twin.experiment(), tilted, {}, known)["rot_disp"] -
                twin.measured_steady_state()["rot_disp"];
   }
@@ -640,8 +641,8 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   for (std::size_t k = 0; k < names.size(); ++k) {
     const bool modelled = names[k] == "rot_disp";
     const double d = modelled ? rotation : effect[names[k]];
-    if (std::isfinite(d) &&
-        (modelled ? kModelledNoise : 1) * std::abs(d) > kNoiseShare * scatter[k])
+    if (std::isfinite(d) && (modelled ? kModelledNoise * std::abs(d) > scatter[k]
+                                      : std::abs(d) > kNoiseShare * scatter[k]))
       limited.push_back({names[k], d, scatter[k], modelled});
   }
   return limited;

@@ -214,6 +214,7 @@ class Twin {
     check_against_experiment(experiment.header(), o_.experiment.string(), settings_,
                              deposit_.box_side);
     errors = scan_errors(experiment);
+    count_located_grains();
     observe = observable_options(o_, experiment, deposit_, errors);
     measured = measured_observables(experiment, observe);
     series_ = series_options();
@@ -272,7 +273,7 @@ class Twin {
   KnownGrains known_grains() const {
     KnownGrains known;
     if (deposit_.polydispersity == 0) known.radius = deposit_.radius;
-    known.count = std::size_t(deposit_.grains);
+    if (!twin_count_differs()) known.count = std::size_t(deposit_.grains);
     return known;
   }
 
@@ -323,25 +324,35 @@ class Twin {
     }
   }
 
-  // The experiment's frames locate fewer (or more) grains than the twin pours: a few
-  // missed by the scans are counted in its height; many mean the twin is not its packing.
-  void note_located_grains() const {
-    std::size_t fewest = std::numeric_limits<std::size_t>::max(), most = 0;
+  // The fewest and most grains located in a frame of the experiment.
+  void count_located_grains() {
+    located_ = {std::numeric_limits<std::size_t>::max(), 0};
     for (std::size_t t = 0; t < experiment_.frame_count(); ++t) {
       const Vectors3 x = experiment_.read_frame(t).position;
       std::size_t located = 0;
       for (Eigen::Index i = 0; i < x.rows(); ++i)
         located += x.row(i).allFinite();
-      fewest = std::min(fewest, located);
-      most = std::max(most, located);
+      located_ = {std::min(located_.first, located), std::max(located_.second, located)};
     }
+  }
+  // More than 5 % apart: the twin is not the experiment's packing, and its count is not
+  // the experiment's (its height is then measured with the grains located).
+  bool twin_count_differs() const {
     const auto n = std::size_t(deposit_.grains);
+    const auto [fewest, most] = located_;
+    return std::max(n - std::min(n, fewest), most - std::min(most, n)) > n / 20;
+  }
+  // The experiment's frames locate fewer (or more) grains than the twin pours: a few
+  // missed by the scans are counted in its height; many mean the twin is not its packing.
+  void note_located_grains() const {
+    const auto n = std::size_t(deposit_.grains);
+    const auto [fewest, most] = located_;
     if (fewest == n && most == n) return;
     std::ostringstream line;
     line << "note: the experiment's frames locate " << fewest;
     if (most != fewest) line << "-" << most;
     line << " grains, the twin pours " << n;
-    if (std::max(n - std::min(n, fewest), most - std::min(most, n)) > n / 20) {
+    if (twin_count_differs()) {
       line << ": more than 5 % apart, so the twin is not the experiment's packing; give it "
               "the experiment's grain count ([simulate] grains)";
     } else {
@@ -453,6 +464,7 @@ class Twin {
 
   const CalibrateOptions& o_;
   const TrajectoryReader& experiment_;
+  std::pair<std::size_t, std::size_t> located_{0, 0};  // count_located_grains()
   RunSettings settings_;
   PhysicsOptions physics_;
   DepositOptions deposit_;
@@ -607,18 +619,21 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
 // kNoiseShare of one packing's scatter: the twin's positions are exact, so it would pull
 // the fit by the scans' noise, not by friction (a contact count within a 2 % gap, at a
 // locating error of 1 % of a diameter). Measured by moving the experiment's positions by
-// their own RMS standard error once more; as a scan's position error is 2-3x its standard
+// their own standard errors once more; as a scan's position error is 2-3x its standard
 // error (docs/BENCHMARKS.md), the share is small. The rotation likewise, by tilting its
-// axes once more, but the twin's axes get the same noise: only its size's error, ~10 %
-// (docs/BENCHMARKS.md), so ~20 % of the noise's part (kModelledNoise), can bias the fit,
-// and the rotation is left out where that could exceed one packing's scatter (the noise
-// then most of what is measured).
+// axes once more, but where the twin's axes get the same noise only its size's error,
+// ~10 % (docs/BENCHMARKS.md), can bias the fit: ~20 % of the noise's part where that part
+// grows as sigma^2 (a rotation the noise dominates), less where it grows more slowly; so
+// the rotation is left out where kModelledNoise of the move could exceed one packing's
+// scatter (the noise then most of what is measured). Without noise in the twin's axes
+// (--axis-noise 0) it is judged as the positions are.
 constexpr double kNoiseShare = 0.25;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
   std::string name;
   double effect, scatter;
-  bool modelled;  // the twin adds the same noise (the axes')
+  bool modelled;        // the twin adds the same noise (the axes')
+  bool dropped = true;  // false: kept, as the fit needs more observables than the rest
 };
 
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
@@ -626,8 +641,8 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   SteadyState effect;
   const Eigen::Vector3d e = twin.errors.position;
   if (e.allFinite() && !e.isZero()) {
-    effect = structure_noise_effect(twin.experiment(), twin.observe.window,
-                                    std::sqrt(e.squaredNorm() / 3), {}, twin.known_grains());
+    effect =
+        structure_noise_effect(twin.experiment(), twin.observe.window, e, {}, twin.known_grains());
   }
   double rotation = std::nan("");
   if (twin.errors.axis > 0 && twin.observe.rotations) {
@@ -639,8 +654,9 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   }
   std::vector<NoiseLimited> limited;
   for (std::size_t k = 0; k < names.size(); ++k) {
-    const bool modelled = names[k] == "rot_disp";
-    const double d = modelled ? rotation : effect[names[k]];
+    const bool rotation_k = names[k] == "rot_disp";
+    const bool modelled = rotation_k && twin.observe.axis_noise > 0;
+    const double d = rotation_k ? rotation : effect[names[k]];
     if (std::isfinite(d) && (modelled ? kModelledNoise * std::abs(d) > scatter[k]
                                       : std::abs(d) > kNoiseShare * scatter[k]))
       limited.push_back({names[k], d, scatter[k], modelled});
@@ -654,16 +670,18 @@ template <class Fit, class Refit>
 Fit without_noise_limited(const Twin& twin, Fit fit, Refit refit, std::size_t fewest,
                           std::vector<NoiseLimited>* left_out) {
   if (!twin.options().only.empty()) return fit;
-  const std::vector<NoiseLimited> limited = noise_limited(twin, fit.names, fit.scatter);
+  std::vector<NoiseLimited> limited = noise_limited(twin, fit.names, fit.scatter);
   std::vector<std::string> kept;
   for (const std::string& name : fit.names) {
     if (std::none_of(limited.begin(), limited.end(),
                      [&](const NoiseLimited& l) { return l.name == name; }))
       kept.push_back(name);
   }
-  if (limited.empty() || kept.size() < fewest) return fit;
+  const bool refit_without = !limited.empty() && kept.size() >= fewest;
+  for (NoiseLimited& l : limited)
+    l.dropped = refit_without;
   if (left_out) *left_out = limited;
-  return refit(kept);
+  return refit_without ? refit(kept) : fit;
 }
 
 ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
@@ -691,15 +709,17 @@ void report_noise_limited(const std::vector<NoiseLimited>& limited, std::ostream
                           JsonObject& j) {
   std::vector<std::string> names;
   for (const NoiseLimited& l : limited) {
-    report << std::setprecision(3) << "  note: " << l.name << " left out: the scans' own "
-           << (l.modelled ? "axis" : "locating") << " noise moves it by " << l.effect
+    report << std::setprecision(3) << "  note: " << l.name
+           << (l.dropped ? " left out" : " kept, as the fit needs it,") << ": the scans' own "
+           << (l.name == "rot_disp" ? "axis" : "locating") << " noise moves it by " << l.effect
            << " (one packing's scatter " << l.scatter << ")"
-           << (l.modelled ? ", more than the twin's tilted axes model"
-                          : " and the twin's positions are exact")
-           << " (--only keeps it)\n";
-    names.push_back(l.name);
+           << (l.modelled             ? ", more than the twin's tilted axes model"
+               : l.name == "rot_disp" ? " and the twin's axes are exact"
+                                      : " and the twin's positions are exact")
+           << (l.dropped ? " (--only keeps it)\n" : "\n");
+    if (l.dropped) names.push_back(l.name);
   }
-  j["left_out_for_locating_noise"] = names;
+  j["left_out_for_scan_noise"] = names;
 }
 
 // Strictly inside the range of `simulated`.
@@ -715,18 +735,22 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
   std::ostringstream line;
   line << std::setprecision(3) << "the design's fit: ";
   FrictionRunSpec at;
+  std::vector<NoiseLimited> limited;
   if (o.joint()) {
-    const JointObservableFit f = joint_steady_state_fit(twin, runs);
+    const JointObservableFit f = joint_steady_state_fit(twin, runs, &limited);
     at = {three_digits(f.mu_s), 0, three_digits(f.mu_r)};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << "), mu_r = " << f.mu_r << " (" << f.mu_r_ci95[0] << " - " << f.mu_r_ci95[1] << ")";
   } else {
-    const ObservableFit f = steady_state_fit(twin, runs);
+    const ObservableFit f = steady_state_fit(twin, runs, &limited);
     at = {three_digits(f.mu_s), 0};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << ")";
   }
-  line << ", " << runs.size() << " runs; ";
+  line << ", " << runs.size() << " runs";
+  for (const NoiseLimited& l : limited)
+    if (l.dropped) line << ", without " << l.name << " (the scans' noise)";
+  line << "; ";
   return {at, line.str()};
 }
 

@@ -221,10 +221,12 @@ std::string steady_state_label(const std::string& name) {
 namespace {
 
 // The observables from positions, frame by frame, each position moved by a normal error of
-// `jitter` per axis (the run's length unit; 0: as stored).
+// `jitter` along x, y and z (the run's length unit; zero: as stored).
 void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
                           const StructureOptions& structure, const KnownGrains& known,
-                          CycleRange cycles, double jitter = 0, std::uint64_t seed = 1) {
+                          CycleRange cycles,
+                          const Eigen::Vector3d& jitter = Eigen::Vector3d::Zero(),
+                          std::uint64_t seed = 1) {
   const auto in_range = [&](std::int64_t c) {
     return cycles.second == 0 || (c >= cycles.first && c <= cycles.second);
   };
@@ -242,9 +244,9 @@ void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
     const std::int64_t c = run.steps()[t];
     if (!in_range(c)) continue;
     Vectors3 position = run.read_frame(t).position;
-    if (jitter > 0) {
+    if (!jitter.isZero()) {
       for (Eigen::Index i = 0; i < position.rows(); ++i)
-        position.row(i) += jitter * normal_vector(random).transpose();
+        position.row(i) += jitter.cwiseProduct(normal_vector(random)).transpose();
     }
     const PackingStructure p = packing_structure(position, radius, structure);
     for (auto* e : {&packing, &coordination, &from_height})
@@ -308,9 +310,9 @@ SteadyState window_means(const ObservableSeries& series, CycleRange window) {
   return s;
 }
 
-SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window, double sigma,
-                                   const StructureOptions& structure, const KnownGrains& known,
-                                   std::uint64_t seed) {
+SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window,
+                                   const Eigen::Vector3d& sigma, const StructureOptions& structure,
+                                   const KnownGrains& known, std::uint64_t seed) {
   ObservableSeries plain, jittered;
   add_structure_series(plain, run, structure, known, window);
   add_structure_series(jittered, run, structure, known, window, sigma, seed);

@@ -119,7 +119,7 @@ def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experime
     noisy = granmem.calibrate(scans(1e-4, "noisy", missed=[5]), tmp_path / "cal",
                               progress=lines.append, **FIT, **TWIN)
     summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
-    assert summary["left_out_for_locating_noise"] == ["height_packing_fraction"]
+    assert summary["left_out_for_scan_noise"] == ["height_packing_fraction"]
     assert list(summary["observables"]) == ["rot_disp"]
     assert "height_packing_fraction left out: the scans' own locating noise moves it by" \
         in noisy["report"]

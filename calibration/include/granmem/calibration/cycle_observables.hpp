@@ -130,10 +130,11 @@ ObservableSeries observable_series(const TrajectoryReader& run, const CycleObser
 SteadyState window_means(const ObservableSeries& series, CycleRange window);
 // How far locating noise moves the observables from positions (bulk and height packing
 // fractions, coordination): their window means with every position moved by a further
-// normal error of `sigma` per axis (the run's length unit), minus as measured. On a scan,
-// with sigma its own standard error, what its noise has already done to them: a contact
-// count within a small gap, for one, falls as noise opens touching pairs. No drift.
-SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window, double sigma,
+// normal error of `sigma` along x, y and z (the run's length unit), minus as measured. On a
+// scan, with sigma its own standard errors, what its noise has already done to them: a
+// contact count within a small gap, for one, falls as noise opens touching pairs. No drift.
+SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange window,
+                                   const Eigen::Vector3d& sigma,
                                    const StructureOptions& structure = {},
                                    const KnownGrains& known = {}, std::uint64_t seed = 1);
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at

@@ -111,17 +111,28 @@ double height_packing_fraction(const Vectors3& position, const std::vector<doubl
     if (std::isfinite(r)) known.push_back(r);
   if (known.empty() || !(cross_section > 0)) return std::nan("");
   const double typical = median(known);
-  double bottom = std::numeric_limits<double>::infinity(), top = -bottom, volume = 0;
-  std::size_t located = 0;
+  std::vector<double> bottoms, tops;
+  double volume = 0;
   for (Eigen::Index i = 0; i < position.rows() && std::size_t(i) < radius.size(); ++i) {
     if (!position.row(i).allFinite()) continue;
     const double r = std::isfinite(radius[std::size_t(i)]) ? radius[std::size_t(i)] : typical;
-    bottom = std::min(bottom, position(i, 2) - r);
-    top = std::max(top, position(i, 2) + r);
+    bottoms.push_back(position(i, 2) - r);
+    tops.push_back(-(position(i, 2) + r));  // negated: the highest first below
     volume += 4.0 / 3.0 * M_PI * r * r * r;
-    ++located;
   }
-  if (grains && located > 0) volume *= double(*grains) / double(located);
+  if (bottoms.empty()) return std::nan("");
+  if (grains) volume *= double(*grains) / double(bottoms.size());
+  // A quarter of a layer (the cross-section over d^2) at each end.
+  const auto end_grains = std::clamp<std::size_t>(
+      std::size_t(std::lround(cross_section / (16 * typical * typical))), 1, bottoms.size());
+  const auto mean_of_lowest = [end_grains](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(end_grains - 1), v.end());
+    double sum = 0;
+    for (std::size_t k = 0; k < end_grains; ++k)
+      sum += v[k];
+    return sum / double(end_grains);
+  };
+  const double bottom = mean_of_lowest(bottoms), top = -mean_of_lowest(tops);
   return top > bottom ? volume / (cross_section * (top - bottom)) : std::nan("");
 }
 

@@ -81,5 +81,20 @@ TEST(PackingStructure, TheHeightPackingFractionOfACubicStackIsPiOverSix) {
   EXPECT_TRUE(std::isnan(height_packing_fraction(x, r, 0.0)));
 }
 
+// The packing's ends are the means over a quarter of a layer (here 25 of the 100 grains a
+// layer holds) of the lowest bottoms and the highest tops: one grain located 0.3 d too
+// high moves the top by 0.3 / 25, where the highest grain's top would move 0.3 (a scan's
+// noise pushes the extreme grains outward).
+TEST(PackingStructure, TheHeightIsMeasuredBetweenTheEndLayersNotTheExtremeGrains) {
+  Vectors3 x = lattice(10, 1.0, {Eigen::Vector3d::Zero()}, {0.5, 0.5, 31.7});
+  const std::vector<double> r(std::size_t(x.rows()), 0.5);
+  Eigen::Index highest = 0;
+  x.col(2).maxCoeff(&highest);
+  x(highest, 2) += 0.3;
+  EXPECT_NEAR(height_packing_fraction(x, r, 100.0), M_PI / 6 * 10 / (10 + 0.3 / 25), 1e-12);
+  // Smaller than a quarter of a layer: the ends are the extreme grains.
+  EXPECT_NEAR(height_packing_fraction(x, r, 2.0), M_PI / 6 * 50 * 10 / (10.3), 1e-12);
+}
+
 }  // namespace
 }  // namespace granmem

@@ -220,19 +220,19 @@ CyclicSummary run_until_stopped(Simulation& sim, const CyclicOptions& o, Protoco
 }
 
 // Stopped twice (the second time in a run that was itself resumed), resumed each time from the
-// checkpoint; four cycles, so that a late stop request still finds the run going. The symmetric
-// drive reaches full compression a quarter into the cycle, so a stop lands before or after the
-// full-compression frame and force are recorded.
+// checkpoint; eight cycles, so that a stop request the loaded machine delays by a few cycles
+// still finds the run going. The symmetric drive reaches full compression a quarter into the cycle,
+// so a stop lands before or after the full-compression frame and force are recorded.
 TEST_F(Restart, StoppedInCyclesAndResumedTwiceWritesTheSameRunBitForBit) {
   fs::create_directories(path("whole"));
-  CyclicOptions a = cycles_into(path("whole"), 4);
+  CyclicOptions a = cycles_into(path("whole"), 8);
   a.drive.symmetry = DriveSymmetry::symmetric;
   Simulation whole = small_packing();
   ProtocolState whole_state;
   run_cycles(whole, a, whole_state);
 
   fs::create_directories(path("parts"));
-  CyclicOptions b = cycles_into(path("parts"), 4);
+  CyclicOptions b = cycles_into(path("parts"), 8);
   b.drive.symmetry = DriveSymmetry::symmetric;
   Simulation sim = small_packing();
   ProtocolState state;
@@ -249,7 +249,7 @@ TEST_F(Restart, StoppedInCyclesAndResumedTwiceWritesTheSameRunBitForBit) {
                    "cycle " + std::to_string(state.cycles_done + 1) + " step " +
                        std::to_string(state.step_in_cycle));
   }
-  EXPECT_EQ(run_cycles(sim, b, state).cycles_done, 4);
+  EXPECT_EQ(run_cycles(sim, b, state).cycles_done, 8);
   expect_same_outputs(a, b);
   expect_same_state(whole, sim);
 }

@@ -39,9 +39,12 @@ PackingStructure packing_structure(const Vectors3& position, const std::vector<d
 
 // The packing fraction of the whole packing from its height: the grains' volume over the
 // container's cross-section (`cross_section`, m^2 or the positions' unit squared) times
-// the height from the lowest grain's bottom to the highest grain's top, which is where
-// the floor and a free lid are. From positions alone, so a scan measures it as the DEM's
-// lid does, without registering the scan to the container's floor. With `grains`, the
+// the height from the packing's bottom to its top, which is where the floor and a free lid
+// are: each the mean over a quarter of a layer's grains (the cross-section over 4 d^2) of
+// the lowest grains' bottoms and the highest grains' tops, not the one extreme grain,
+// whose place a scan's locating noise pushes outward. From positions alone, so a scan
+// measures it as the DEM's lid does, without registering the scan to the container's
+// floor. With `grains`, the
 // count the packing is known to hold, the located grains' volume is scaled to it (a scan
 // that missed some grains still sees the packing's height). NaN without grains or
 // cross-section.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "granmem/core/point_index.hpp"
 #include "granmem/core/statistics.hpp"
@@ -122,7 +121,7 @@ double height_packing_fraction(const Vectors3& position, const std::vector<doubl
   }
   if (bottoms.empty()) return std::nan("");
   if (grains) volume *= double(*grains) / double(bottoms.size());
-  // A quarter of a layer (the cross-section over d^2) at each end.
+  // A quarter of a layer (a layer: the cross-section over d^2) at each end.
   const auto end_grains = std::clamp<std::size_t>(
       std::size_t(std::lround(cross_section / (16 * typical * typical))), 1, bottoms.size());
   const auto mean_of_lowest = [end_grains](std::vector<double>& v) {

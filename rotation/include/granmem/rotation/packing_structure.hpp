@@ -44,10 +44,9 @@ PackingStructure packing_structure(const Vectors3& position, const std::vector<d
 // the lowest grains' bottoms and the highest grains' tops, not the one extreme grain,
 // whose place a scan's locating noise pushes outward. From positions alone, so a scan
 // measures it as the DEM's lid does, without registering the scan to the container's
-// floor. With `grains`, the
-// count the packing is known to hold, the located grains' volume is scaled to it (a scan
-// that missed some grains still sees the packing's height). NaN without grains or
-// cross-section.
+// floor. With `grains`, the count the packing is known to hold, the located grains' volume
+// is scaled to it (a scan that missed some grains still sees the packing's height). NaN
+// without grains or cross-section.
 double height_packing_fraction(const Vectors3& position, const std::vector<double>& radius,
                                double cross_section, std::optional<std::size_t> grains = {});
 

@@ -14,7 +14,7 @@ void add_readout(CLI::App& app) {
     std::vector<std::string> from;
     std::string amplitudes = "0.05%:2.5%:12", out, drive = "asymmetric", wall_motion = "cosine";
     std::int64_t cycles = 1;
-    double inertial_number = 1e-3;
+    double inertial_number = ReadoutSweepOptions{}.inertial_number;
     bool training_amplitude = true;
     int parallel = 0;
     std::size_t bootstrap = 200;

@@ -73,7 +73,7 @@ for name in $names; do
 done
 
 steady="$out/steady_state.csv"
-echo "# steady state over cycles $window: means of the end-of-cycle translational (dr) and rotational (rot_disp = single-axis angle x radius) displacements in grain diameters; KS distance and p-value against the slowest drive of the same mu_s and seed, and seed 1 against seed 2 at the same drive (the seed-to-seed yardstick)" > "$steady"
+echo "# steady state over cycles $window: means of the end-of-cycle translational (dr) and rotational (rot_disp = single-axis angle x radius) displacements in grain diameters; KS distance and p-value against the slowest drive of the same mu_s and seed, and seed 1 against seed 2 (3 against 4, ...) at the same drive (the seed-to-seed yardstick), on the odd seed's row" > "$steady"
 echo "mu_s,seed,inertial_number,mean_dr_d,mean_rot_disp_d,packing_fraction,wall_force_full_compression_N,ks_dr_vs_slowest,ks_p_dr_vs_slowest,ks_rot_vs_slowest,ks_p_rot_vs_slowest,ks_dr_seed1_vs_seed2,ks_rot_seed1_vs_seed2" >> "$steady"
 for name in $names; do
   read -r mu seed inertial <<< "$(parse "$name")"
@@ -89,10 +89,11 @@ for name in $names; do
   else
     ks=$(distance_row "$work/vs_slowest_$name/distances.csv" 1 | awk '{ printf "%s,%s", $3, $4 }'),$(distance_row "$work/vs_slowest_$name/distances.csv" 2 | awk '{ printf "%s,%s", $3, $4 }')
   fi
-  other="mu${mu}_seed2_I${inertial}"
-  if [[ $seed == 1 && -e $runs/$other.done ]]; then
-    compare "$runs/$name.h5" "$runs/$other.h5" "$work/seeds_mu${mu}_I${inertial}"
-    seeds=$(distance_row "$work/seeds_mu${mu}_I${inertial}/distances.csv" 1 | awk '{ printf "%s", $3 }'),$(distance_row "$work/seeds_mu${mu}_I${inertial}/distances.csv" 2 | awk '{ printf "%s", $3 }')
+  other="mu${mu}_seed$((seed + 1))_I${inertial}"  # pairs of seeds: 1 with 2, 3 with 4, ...
+  if ((seed % 2 == 1)) && [[ -e $runs/$other.done ]]; then
+    pair="$work/seeds${seed}_mu${mu}_I${inertial}"
+    compare "$runs/$name.h5" "$runs/$other.h5" "$pair"
+    seeds=$(distance_row "$pair/distances.csv" 1 | awk '{ printf "%s", $3 }'),$(distance_row "$pair/distances.csv" 2 | awk '{ printf "%s", $3 }')
   else
     seeds="nan,nan"
   fi
@@ -107,6 +108,7 @@ sort -t, -k1,1g -k2,2n -k3,3g -o "$steady.body" <(grep -v "^#\|^mu_s" "$steady")
 # seed 2), and the steady state against the inertial number.
 inertials=$(grep -v "^#\|^mu_s" "$steady" | cut -d, -f3 | sort -gu | tr '\n' ',' | sed 's/,$//')
 frictions=$(grep -v "^#\|^mu_s" "$steady" | cut -d, -f1 | sort -gu | tr '\n' ',' | sed 's/,$//')
+seeds=$(grep -v "^#\|^mu_s" "$steady" | cut -d, -f2 | sort -gu | tr '\n' ',' | sed 's/,$//')
 gnuplot <<EOF
 set terminal pngcairo size 1400,1400 font ",11"
 set output "$out/quasistatic.png"
@@ -114,6 +116,7 @@ set datafile separator ","
 set termoption noenhanced
 array I[$(echo "$inertials" | tr ',' '\n' | wc -l)] = [$inertials]
 array M[$(echo "$frictions" | tr ',' '\n' | wc -l)] = [$frictions]
+array S[$(echo "$seeds" | tr ',' '\n' | wc -l)] = [$seeds]
 is(x, y) = abs(x / y - 1) < 1e-9
 set multiplot layout 3,2 title "Quasi-static limit: 1,500 grains, 5 cm box, lid 436 Pa, A = 1 % (drift removed, grains > 1 d from the walls)"
 set key top right
@@ -131,18 +134,18 @@ set xlabel "inertial number I"
 set key top left
 set title "steady state (cycles $window): mean end-of-cycle displacement"
 set ylabel "mean dr (grain diameters)"
-plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):4 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+plot for [m = 1:|M|] for [s = 1:|S|] "$steady" using ((is(\$1, M[m]) && \$2 == S[s]) ? \$3 : NaN):4 with linespoints lw 2 lc m pt 4 + s title sprintf("mu_s %g, seed %d", M[m], S[s])
 set title "steady state: mean rotational displacement (single-axis angle x radius)"
 set ylabel "mean rot_disp (grain diameters)"
-plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):5 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+plot for [m = 1:|M|] for [s = 1:|S|] "$steady" using ((is(\$1, M[m]) && \$2 == S[s]) ? \$3 : NaN):5 with linespoints lw 2 lc m pt 4 + s title sprintf("mu_s %g, seed %d", M[m], S[s])
 set key center left
 set title "steady state: packing fraction"
 set ylabel "packing fraction"
-plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):6 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+plot for [m = 1:|M|] for [s = 1:|S|] "$steady" using ((is(\$1, M[m]) && \$2 == S[s]) ? \$3 : NaN):6 with linespoints lw 2 lc m pt 4 + s title sprintf("mu_s %g, seed %d", M[m], S[s])
 set key center right
 set title "steady state: force on the driven wall at full compression"
 set ylabel "force (N)"
-plot for [m = 1:|M|] for [s = 1:2] "$steady" using ((is(\$1, M[m]) && \$2 == s) ? \$3 : NaN):7 with linespoints lw 2 pt 7 title sprintf("mu_s %g, seed %d", M[m], s)
+plot for [m = 1:|M|] for [s = 1:|S|] "$steady" using ((is(\$1, M[m]) && \$2 == S[s]) ? \$3 : NaN):7 with linespoints lw 2 lc m pt 4 + s title sprintf("mu_s %g, seed %d", M[m], S[s])
 unset multiplot
 EOF
 echo "wrote $per_cycle, $steady, $out/quasistatic.png"

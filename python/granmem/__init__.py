@@ -265,7 +265,7 @@ def simulate(out=None, resume=None, start_from=None, threads=0, progress=None,
 
 
 def readout(states, out, amplitudes="0.05%:2.5%:12", cycles=1, drive="asymmetric",
-            wall_motion="cosine", inertial_number=1e-3, training_amplitude=True, parallel=0,
+            wall_motion="cosine", inertial_number=None, training_amplitude=True, parallel=0,
             bootstrap=200, progress=None):
     """The paper's memory read-out, as ``granmem readout``: one run of ``cycles`` cycles at
     each amplitude A' from each trained state (checkpoints, e.g. ``simulate(...,
@@ -273,7 +273,8 @@ def readout(states, out, amplitudes="0.05%:2.5%:12", cycles=1, drive="asymmetric
     runs are reused when called again).
 
     ``amplitudes``: "lo%:hi%:count" (log-spaced) or a list of percentages, e.g. [0.5, 1, 2].
-    Returns a dict: ``points`` (a DataFrame of the read-out curves: state, amplitude_pct,
+    ``inertial_number``: the drive's quasi-static limit (None: granmem's default, as
+    ``simulate``'s). Returns a dict: ``points`` (a DataFrame of the read-out curves: state, amplitude_pct,
     cycle, dr_d, msd_d2, rotations, their errors) and ``signatures`` (each state's memory:
     the dip at its training amplitude, the ratio to an untrained packing, the rotations'
     power laws). Ctrl-C stops after the runs under way and is raised."""
@@ -282,7 +283,9 @@ def readout(states, out, amplitudes="0.05%:2.5%:12", cycles=1, drive="asymmetric
     if isinstance(states, (str, os.PathLike)):
         states = [states]
     out_dict = _granmem.readout([os.fspath(s) for s in states], os.fspath(out), amplitudes,
-                                int(cycles), drive, wall_motion, float(inertial_number),
+                                int(cycles), drive, wall_motion,
+                                _granmem.QUASI_STATIC_INERTIAL_NUMBER
+                                if inertial_number is None else float(inertial_number),
                                 bool(training_amplitude), int(parallel), int(bootstrap),
                                 progress)
     return {"points": _frame(*out_dict["points"], length_unit="d"),

@@ -861,6 +861,7 @@ PYBIND11_MODULE(_granmem, m) {
   using namespace granmem::python;
   m.doc() = "granmem's libraries: locate, link, render, trajectory stores, grain motion";
   m.attr("__version__") = granmem::kVersion;
+  m.attr("QUASI_STATIC_INERTIAL_NUMBER") = granmem::kQuasiStaticInertialNumber;
   static py::exception<Error> error(m, "Error", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
     try {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "granmem/sim/quasi_static.hpp"
 #include "granmem/sim/run_pool.hpp"
 #include "granmem/sim/wall_drive.hpp"
 
@@ -25,7 +26,7 @@ struct ReadoutSweepOptions {
   // The wall's peak speed is the quasi-static speed of this inertial number under the
   // state's lid (docs/QUASISTATIC.md), so the period grows with A'. A' = 0 keeps the wall
   // still for the period of the smallest positive amplitude.
-  double inertial_number = 1e-3;
+  double inertial_number = kQuasiStaticInertialNumber;
   // Each state's own training amplitude (its `amplitude` setting) is added to its sweep.
   bool include_training_amplitude = true;
   std::filesystem::path dir;  // the runs' stores (readout_run_path), made if missing

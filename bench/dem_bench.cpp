@@ -193,7 +193,7 @@ int tile(const std::vector<std::string>& a) {
 }
 
 // Steps per cycle of the paper's protocol as `granmem simulate` sets it by default
-// (--period auto: a cosine drive of A = 1 % of the 15 cm box at inertial number 1e-3
+// (--period auto: a cosine drive of A = 1 % of the 15 cm box at the default inertial number
 // under the paper's lid pressure), with this packing's grains and time step.
 double paper_steps_per_cycle(const Simulation& sim) {
   const auto& p = sim.physics();
@@ -202,8 +202,9 @@ double paper_steps_per_cycle(const Simulation& sim) {
   drive.amplitude = 0.01 * kPaperBox;
   const double stress =
       granmem::confining_stress(granmem::kPaperLidPressure, p.density, p.gravity, diameter);
-  return std::round(
-      granmem::quasi_static_period(1e-3, drive, kPaperBox, diameter, stress, p.density) / p.dt);
+  return std::round(granmem::quasi_static_period(granmem::kQuasiStaticInertialNumber, drive,
+                                                 kPaperBox, diameter, stress, p.density) /
+                    p.dt);
 }
 
 int time_run(const std::vector<std::string>& a) {

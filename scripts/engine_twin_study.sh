@@ -57,7 +57,7 @@ case "$out" in /*) ;; *) out="$PWD/$out" ;; esac
 run_one() {
   local engine=$1 seed=$2
   resumable_run "$out" "${engine}_seed${seed}" "$cycles" --grains "$grains" --box 5cm \
-    --amplitude 1% --seed "$seed" --checkpoint-every 5 --engine "$engine" --ranks "$ranks"
+    --amplitude 1% --inertial-number 1e-3 --seed "$seed" --checkpoint-every 5 --engine "$engine" --ranks "$ranks"
 }
 export -f run_one
 export out cycles grains granmem ranks

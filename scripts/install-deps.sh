@@ -12,7 +12,7 @@ packages=(
   libopenmpi-dev openmpi-bin
   lammps
   python3-dev pybind11-dev python3-numpy python3-pandas python3-pytest python3-matplotlib
-  python3-h5py python3-ase
+  python3-h5py python3-ase python3-scipy
   "$@"
 )
 

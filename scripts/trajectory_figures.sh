@@ -56,7 +56,7 @@ for m in $mus; do
     n=$(h5dump -H -d /particles/grains/id "$runs/mu${m}_seed${seed}.h5" | awk -F'[()]' '/DATASPACE/ { print $2; exit }')
     ids=$(seq -s, 0 $((n - 1)))
     OMP_NUM_THREADS=1 "$granmem" simulate --start-from "$state" --cycles 3 --threads 1 \
-      --track "$ids" --samples-per-cycle "$samples" --out "$run" > "$runs/trajectories_mu$m.log" 2>&1
+      --inertial-number 1e-3 --track "$ids" --samples-per-cycle "$samples" --out "$run" > "$runs/trajectories_mu$m.log" 2>&1
   fi
   "$granmem" export "$run" --out "$runs/trajectories_mu$m.end.dump" > /dev/null
   "$granmem" export "${run%.h5}_in_cycle.h5" --out "$runs/trajectories_mu$m.in.dump" > /dev/null

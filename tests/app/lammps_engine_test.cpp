@@ -21,7 +21,7 @@ using testing::GranmemTest;
 class LammpsEngine : public GranmemTest {};
 
 // 150 grains in a 2.5 cm box under the paper's lid pressure, A = 1 %, the automatic
-// (quasi-static) period: 14,618 steps a cycle.
+// (quasi-static) period: 7,309 steps a cycle.
 std::vector<std::string> small_run(const std::string& out, const std::string& cycles) {
   return {"simulate", "--grains", "150", "--box", "2.5cm", "--cycles", cycles, "--out", out};
 }

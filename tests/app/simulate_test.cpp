@@ -74,16 +74,16 @@ TEST_F(GranmemTest, SimulateLidPressesWithThePapersPressureInAnyBox) {
   EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
   EXPECT_FALSE(fs::exists(in_work("b.h5")));
 
-  // The period for I = 1e-3 (5 mm grains, 1 % of the box): the paper's 0.365454 s at its
-  // pressure, half that at 4x the pressure.
+  // The period for the default I = 2e-3 (5 mm grains, 1 % of the box): the paper's
+  // 0.182727 s at its pressure (half that of I = 1e-3), half that at 4x the pressure.
   auto period = [&](const std::string& pressure) {
     const RunResult r = granmem_ok({"simulate", "--grains", "60", "--box", "2cm", "--cycles", "1",
                                     "--lid-pressure", pressure, "--out", pressure + ".h5"});
     const auto at = r.err.find("period ");
     return at == std::string::npos ? -1.0 : std::stod(r.err.substr(at + 7));
   };
-  EXPECT_NEAR(period("436Pa"), 0.365454, 1e-6);
-  EXPECT_NEAR(period("1744Pa"), 0.365454 / 2, 1e-6);
+  EXPECT_NEAR(period("436Pa"), 0.365454 / 2, 1e-6);
+  EXPECT_NEAR(period("1744Pa"), 0.365454 / 4, 1e-6);
 }
 
 TEST_F(GranmemTest, SimulateResumedGivesTheSameRun) {

@@ -14,8 +14,8 @@ inline constexpr double kPaperLidPressure = 1.0 * 9.81 / (0.15 * 0.15);  // Pa
 // The default drive: the fastest inertial number whose steady state agrees with the
 // slowest measured within two packings' difference (docs/QUASISTATIC.md), as a number and
 // as the option's text.
-inline constexpr double kQuasiStaticInertialNumber = 1e-3;
-inline constexpr const char* kQuasiStaticInertialNumberText = "1e-3";
+inline constexpr double kQuasiStaticInertialNumber = 2e-3;
+inline constexpr const char* kQuasiStaticInertialNumberText = "2e-3";
 
 // Mass of a lid that presses with `pressure` on a box of floor `box_x` x `box_y`.
 double lid_mass_for_pressure(double pressure, double gravity, double box_x, double box_y);

@@ -32,6 +32,16 @@ double median(std::vector<double> values) {
   return quantile_in_place(values, 0.5);
 }
 
+double mean_of_smallest(std::vector<double> values, std::size_t count) {
+  count = std::min(count, values.size());
+  if (count == 0) return std::nan("");
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(count - 1), values.end());
+  double sum = 0;
+  for (std::size_t k = 0; k < count; ++k)
+    sum += values[k];
+  return sum / double(count);
+}
+
 double bootstrap_standard_error(const std::vector<double>& values, std::size_t resamples,
                                 Random& random) {
   std::vector<double> v;

@@ -124,14 +124,8 @@ double height_packing_fraction(const Vectors3& position, const std::vector<doubl
   // A quarter of a layer (a layer: the cross-section over d^2) at each end.
   const auto end_grains = std::clamp<std::size_t>(
       std::size_t(std::lround(cross_section / (16 * typical * typical))), 1, bottoms.size());
-  const auto mean_of_lowest = [end_grains](std::vector<double>& v) {
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(end_grains - 1), v.end());
-    double sum = 0;
-    for (std::size_t k = 0; k < end_grains; ++k)
-      sum += v[k];
-    return sum / double(end_grains);
-  };
-  const double bottom = mean_of_lowest(bottoms), top = -mean_of_lowest(tops);
+  const double bottom = mean_of_smallest(std::move(bottoms), end_grains);
+  const double top = -mean_of_smallest(std::move(tops), end_grains);
   return top > bottom ? volume / (cross_section * (top - bottom)) : std::nan("");
 }
 

@@ -197,20 +197,24 @@ TEST_F(LinkCommandTest, PositionsAreStoredInTheContainersFrame) {
       EXPECT_TRUE(shift.row(k).isApprox(Eigen::RowVector3d(-1, 2, 3), 1e-9)) << shift.row(k);
     }
   }
-  // Found from the packing's extent: the lowest surfaces in the first scan are the
-  // container's lower corner.
+  // Found from the packing's extent: across x and y the surfaces' extent in the first scan
+  // centred in the container, along z the lowest surface on its floor.
   granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "found.h5", "--container-size", "5,5,7cm"});
   const Trajectories found = read_trajectories(in_work("found.h5"));
   ASSERT_TRUE(found.header.box.has_value());
   EXPECT_TRUE(found.header.box->edges.isApprox(Eigen::Vector3d(50, 50, 70)));
-  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(1e9);
+  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(1e9), highest = -lowest;
   for (Eigen::Index k = 0; k < found.frames[0].position.rows(); ++k) {
     const double r = found.header.radius[std::size_t(k)];
-    if (found.frames[0].position.row(k).allFinite() && std::isfinite(r))
-      lowest = lowest.cwiseMin(found.frames[0].position.row(k).transpose() -
+    if (!found.frames[0].position.row(k).allFinite() || !std::isfinite(r)) continue;
+    lowest =
+        lowest.cwiseMin(found.frames[0].position.row(k).transpose() - Eigen::Vector3d::Constant(r));
+    highest = highest.cwiseMax(found.frames[0].position.row(k).transpose() +
                                Eigen::Vector3d::Constant(r));
   }
-  EXPECT_LT(lowest.norm(), 1e-9) << lowest.transpose();
+  EXPECT_NEAR(lowest.x() + highest.x(), 50, 1e-9);
+  EXPECT_NEAR(lowest.y() + highest.y(), 50, 1e-9);
+  EXPECT_NEAR(lowest.z(), 0, 1e-9);
   expect_clean_failure({"link", "scan0.h5", "scan1.csv", "--out", "x.h5", "--container-size",
                         "5,5,7cm", "--container", "0,0,0,5,5,7cm"},
                        {"not both"});

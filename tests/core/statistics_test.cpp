@@ -292,5 +292,13 @@ TEST(Quantile, IgnoresNonFiniteValuesAndIsNanWithoutAny) {
   EXPECT_TRUE(std::isnan(quantile({}, 0.5)));
 }
 
+TEST(MeanOfSmallest, AveragesTheSmallestValuesWhateverTheirOrder) {
+  EXPECT_DOUBLE_EQ(mean_of_smallest({5, 1, 4, 2, 3}, 2), 1.5);
+  EXPECT_DOUBLE_EQ(mean_of_smallest({5, 1, 4, 2, 3}, 1), 1);
+  EXPECT_DOUBLE_EQ(mean_of_smallest({5, 1, 4}, 10), 10.0 / 3);  // all of them
+  EXPECT_TRUE(std::isnan(mean_of_smallest({}, 3)));
+  EXPECT_TRUE(std::isnan(mean_of_smallest({1, 2}, 0)));
+}
+
 }  // namespace
 }  // namespace granmem

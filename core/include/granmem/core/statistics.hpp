@@ -30,6 +30,9 @@ double quantile(std::vector<double> values, double p);
 double quantile_in_place(std::vector<double>& values, double p);
 // quantile(values, 0.5).
 double median(std::vector<double> values);
+// The mean of the `count` smallest values (all of them if fewer; NaN if none), in O(n):
+// a packing's end layer, less noisy than its one extreme grain.
+double mean_of_smallest(std::vector<double> values, std::size_t count);
 
 // The 97.5 % point of Student's t with `dof` degrees of freedom (Cornish-Fisher expansion
 // about the normal's 1.96; within 0.2 % for dof >= 3; the normal's for dof <= 0): a 95 %

@@ -90,9 +90,15 @@ struct Trajectories {
 // without positive edges.
 void register_to_container(Trajectories& run, const Box& container);
 
-// The container of edges `edges` found from the packing's extent in the first frame: its
-// lower corner where the grains' surfaces end (lowest x - r, y - r, z - r), since grains
-// pressed into a container touch its floor and walls. Error for a run without positions.
+// The container of edges `edges` found from the packing's extent in the first frame, since
+// grains pressed into a container touch its floor and walls. Each end of the packing is
+// its end layer: the mean over a quarter of a layer's grains (the packing's face over
+// 4 d^2) of the surfaces nearest that wall (x - r, ..., or x + r), not the one
+// extreme grain that noise pushes outward. Across x and y the packing is centred between
+// the walls, so that radii located too small or too large, and noise, alike on both sides,
+// cancel; along z the floor is at the lowest surface (z - r; the lid is free, so the top is
+// no wall, and the radii's error stays: noise pushing the lowest grain outward offsets
+// some of it). Error for a run without positions.
 Box container_from_extent(const Trajectories& run, const Eigen::Vector3d& edges);
 
 // Checks a header for consistency (sizes, unique ids, known units); throws Error naming `where`.

@@ -86,7 +86,9 @@ namespace {
 // negated (-(x + r)), so that the smallest of each are the nearest a wall.
 struct PackingSurfaces {
   std::array<std::vector<double>, 3> low, high;
-  double radius = 0;  // the median grain's
+  Eigen::Vector3d lowest = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d highest = -lowest;  // the extreme surfaces
+  double radius = 0;                  // the median grain's
 };
 
 PackingSurfaces first_frame_surfaces(const Trajectories& run) {
@@ -103,6 +105,8 @@ PackingSurfaces first_frame_surfaces(const Trajectories& run) {
       s.low[a].push_back(f.position(k, a) - r);
       s.high[a].push_back(-(f.position(k, a) + r));
     }
+    s.lowest = s.lowest.cwiseMin(f.position.row(k).transpose() - Eigen::Vector3d::Constant(r));
+    s.highest = s.highest.cwiseMax(f.position.row(k).transpose() + Eigen::Vector3d::Constant(r));
   }
   if (!radii.empty()) s.radius = median(radii);
   return s;
@@ -112,11 +116,8 @@ PackingSurfaces first_frame_surfaces(const Trajectories& run) {
 // packing's face, its extent across the other two axes, over 4 d^2) of the surfaces
 // nearest that side, as the packing's height is measured.
 double end_layer(const PackingSurfaces& s, int axis, const std::vector<double>& surfaces) {
-  const auto span = [&s](int a) {
-    return -*std::min_element(s.high[a].begin(), s.high[a].end()) -
-           *std::min_element(s.low[a].begin(), s.low[a].end());
-  };
-  const double face = span((axis + 1) % 3) * span((axis + 2) % 3);
+  const Eigen::Vector3d span = s.highest - s.lowest;
+  const double face = span[(axis + 1) % 3] * span[(axis + 2) % 3];
   const double count = std::max(1.0, std::round(face / (16 * s.radius * s.radius)));
   return mean_of_smallest(surfaces, std::size_t(count));
 }
@@ -136,7 +137,7 @@ Box container_from_extent(const Trajectories& run, const Eigen::Vector3d& edges)
   Eigen::Vector3d lower;
   for (int a = 0; a < 2; ++a)
     lower[a] = (end_layer(s, a, s.low[a]) - end_layer(s, a, s.high[a]) - edges[a]) / 2;
-  lower.z() = *std::min_element(s.low[2].begin(), s.low[2].end());
+  lower.z() = s.lowest.z();
   return Box{lower, edges};
 }
 

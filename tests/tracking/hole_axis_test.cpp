@@ -85,8 +85,9 @@ TEST(HoleAxis, NoTiltUnderABlurWiderAlongZ) {
   std::cout << "tilt: whole-grain model " << model_tilt << " deg, inner refit " << refit_tilt
             << " deg; blur across " << refit.blur_across << ", along z " << refit.blur_along_z
             << "\n";
-  // Without noise: the whole-grain model tilts by 4.9 deg, the refit by 0.045 (the image
-  // blurred exactly; 0.13 with the sphere's rim blurred as a plane and the radius held).
+  // Without noise: the whole-grain model tilts by 2.5 deg (its hole blurred as a plane; 4.9
+  // with one blur alike in every direction), the refit by 0.04 (the image blurred exactly;
+  // 0.13 with the sphere's rim blurred as a plane and the radius held).
   EXPECT_GT(model_tilt, 2.0);  // what the refit is for
   EXPECT_LT(refit_tilt, 0.1);
   // The blurs and the radius it finds are those of the scan.

@@ -120,7 +120,8 @@ void subtract_found(Volume& vol, const Stack& stack, const Eigen::Array3i& bin,
   for (const HoledSphere& g : found) {
     const Eigen::Vector3d c = g.centre.cwiseQuotient(voxel_size);
     const Eigen::Vector3d reach =
-        Eigen::Vector3d::Constant(g.radius + 3 * g.blur).cwiseQuotient(voxel_size);
+        Eigen::Vector3d(g.radius + 3 * g.blur, g.radius + 3 * g.blur, g.radius + 3 * g.along_z())
+            .cwiseQuotient(voxel_size);
     const Eigen::Vector3d lo = (c - reach).array().ceil().max(0.0);
     const Eigen::Vector3d hi = (c + reach).array().floor().min(
         Eigen::Array3d(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1)));

@@ -10,14 +10,14 @@ namespace {
 
 // Residuals model - data of every voxel, with their Jacobian, for TinySolver. Parameters:
 // centre (3, from `origin`: the step tolerance is relative to the parameters, which must
-// not depend on where the grain lies in the stack), radius, log blur (keeps the blur positive),
-// fluid level, grain level, and with a hole two tangent coordinates of the axis around `axis0` (no
-// pole to trip on).
+// not depend on where the grain lies in the stack), radius, log blur across the slices (the
+// log keeps it positive), fluid level, grain level, log blur along z, and with a hole two
+// tangent coordinates of the axis around `axis0` (no pole to trip on).
 template <int kParameters>
 struct GrainResiduals {
   using Scalar = double;
   enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = kParameters };
-  static constexpr bool kAxis = kParameters == 9;
+  static constexpr bool kAxis = kParameters == 10;
 
   const GrainWindow* window;
   Eigen::Vector3d origin;
@@ -28,7 +28,7 @@ struct GrainResiduals {
 
   Eigen::Vector3d axis_of(const double* x, Eigen::Vector3d* v = nullptr) const {
     if (!kAxis) return axis0;
-    const Eigen::Vector3d raw = axis0 + x[7] * e1 + x[8] * e2;
+    const Eigen::Vector3d raw = axis0 + x[8] * e1 + x[9] * e2;
     if (v) *v = raw;
     return raw.normalized();
   }
@@ -38,6 +38,7 @@ struct GrainResiduals {
     s.centre = origin + Eigen::Vector3d(x[0], x[1], x[2]);
     s.radius = x[3];
     s.blur = std::exp(x[4]);
+    s.blur_z = std::exp(x[7]);
     s.hole = hole;
     Eigen::Vector3d raw;
     s.axis = axis_of(x, &raw);
@@ -68,9 +69,10 @@ struct GrainResiduals {
       J(4) = scale * m.d_blur * s.blur;  // d/d log s
       J(5) = 1 - dark;
       J(6) = dark;
+      J(7) = scale * m.d_blur_z * s.blur_z;
       if (kAxis) {
-        J(7) = scale * m.d_axis.dot(da1);
-        J(8) = scale * m.d_axis.dot(da2);
+        J(8) = scale * m.d_axis.dot(da1);
+        J(9) = scale * m.d_axis.dot(da2);
       }
     }
     return true;
@@ -90,6 +92,7 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
   x[4] = std::log(start.blur);
   x[5] = 1;  // normalised levels
   x[6] = 0;
+  x[7] = std::log(start.along_z());
   ceres::TinySolver<GrainResiduals<kParameters>> solver;
   solver.options.max_num_iterations = options.max_iterations;
   // Steps under 1e-4 x |parameters| (~6e-4 voxel for a 12-voxel grain) change nothing.
@@ -101,6 +104,7 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
   fit.sphere.centre = start.centre + x.template head<3>();
   fit.sphere.radius = x[3];
   fit.sphere.blur = std::exp(x[4]);
+  fit.sphere.blur_z = std::exp(x[7]);
   fit.sphere.hole = start.hole;
   fit.sphere.axis = f.axis_of(x.data());
   fit.fluid = x[5];
@@ -116,7 +120,7 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
   fit.centre_sigma = covariance->diagonal().template head<3>().cwiseMax(0).cwiseSqrt();
   if constexpr (GrainResiduals<kParameters>::kAxis) {
     fit.axis_sigma =
-        axis_standard_error(*covariance, 7, (f.axis0 + x[7] * f.e1 + x[8] * f.e2).norm());
+        axis_standard_error(*covariance, 8, (f.axis0 + x[8] * f.e1 + x[9] * f.e2).norm());
   }
   return fit;
 }
@@ -125,8 +129,8 @@ GrainFit solve(const GrainWindow& window, const HoledSphere& start,
 
 GrainFit fit_grain(const GrainWindow& window, const HoledSphere& start,
                    const GrainFitOptions& options) {
-  if (start.hole > 0 && options.fit_axis) return solve<9>(window, start, options);
-  return solve<7>(window, start, options);
+  if (start.hole > 0 && options.fit_axis) return solve<10>(window, start, options);
+  return solve<8>(window, start, options);
 }
 
 }  // namespace granmem

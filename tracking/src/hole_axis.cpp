@@ -233,7 +233,7 @@ HoleAxisFit fit_hole_axis(const GrainWindow& inner, const GrainFit& grain,
   Eigen::Matrix<double, 7, 1> x;
   const HoleAxisStart& s = o.start;
   x << std::log(s.blur_across > 0 ? s.blur_across : grain.sphere.blur),
-      std::log(s.blur_along_z > 0 ? s.blur_along_z : grain.sphere.blur),
+      std::log(s.blur_along_z > 0 ? s.blur_along_z : grain.sphere.along_z()),
       grain.fluid + s.fluid_change, grain.grain + s.grain_change, 0, 0,
       s.radius_change / grain.sphere.radius;
   model.e1 = model.axis0.unitOrthogonal();

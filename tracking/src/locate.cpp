@@ -58,17 +58,17 @@ struct Candidate {
   bool fitted = false, active = true;
 };
 
-// The voxels within `reach` of `centre` into `window`, each with how much of it the
-// neighbours leave clear, `clear_at(p, d)` (d: p's distance from the centre); voxels left
-// under 1e-3 clear are left out (they say nothing of this grain); the clear shares kept
-// only `with_clear`.
+// The voxels within the ellipsoid of semi-axes `reach` (x, y, z) around `centre` into
+// `window`, each with how much of it the neighbours leave clear, `clear_at(p, d)` (d: p's
+// distance from the centre); voxels left under 1e-3 clear are left out (they say nothing
+// of this grain); the clear shares kept only `with_clear`.
 template <class ClearAt>
-void fill_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
+void fill_window(const Stack& stack, const Eigen::Vector3d& centre, const Eigen::Vector3d& reach,
                  const Eigen::Vector3d& vs, bool with_clear, const ClearAt& clear_at,
                  GrainWindow& window) {
   const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
-  const Eigen::Vector3d lo = ((centre.array() - reach) / vs.array()).ceil().max(0.0);
-  const Eigen::Vector3d hi = ((centre.array() + reach) / vs.array()).floor().min(last);
+  const Eigen::Vector3d lo = ((centre - reach).array() / vs.array()).ceil().max(0.0);
+  const Eigen::Vector3d hi = ((centre + reach).array() / vs.array()).floor().min(last);
   window.points.clear();
   window.intensity.clear();
   window.clear.clear();
@@ -76,8 +76,8 @@ void fill_window(const Stack& stack, const Eigen::Vector3d& centre, double reach
     for (auto y = std::int64_t(lo.y()); y <= std::int64_t(hi.y()); ++y) {
       for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
         const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
+        if ((p - centre).cwiseQuotient(reach).squaredNorm() > 1) continue;
         const double d = (p - centre).norm();
-        if (d > reach) continue;
         const double clear = clear_at(p, d);
         if (clear < 1e-3) continue;
         window.points.push_back(p);
@@ -88,17 +88,17 @@ void fill_window(const Stack& stack, const Eigen::Vector3d& centre, double reach
   }
 }
 
-// The voxels within `reach` of grain `s`: with `model_neighbours`, each with how much of it
-// the neighbours leave clear, prod (1 - M_neighbour); without, only the voxels nearer this
-// grain than any neighbour.
-void window_of(const Stack& stack, const HoledSphere& s, double reach,
+// The voxels within `reach` (x, y, z) of grain `s`: with `model_neighbours`, each with how much of
+// it the neighbours leave clear, prod (1 - M_neighbour); without, only the voxels nearer this grain
+// than any neighbour.
+void window_of(const Stack& stack, const HoledSphere& s, const Eigen::Vector3d& reach,
                const std::vector<const HoledSphere*>& near, bool model_neighbours,
                const Eigen::Vector3d& vs, GrainWindow& window) {
   const auto clear_at = [&](const Eigen::Vector3d& p, double d) {
     double clear = 1;
     for (const HoledSphere* other : near) {
       if (model_neighbours) {
-        if ((p - other->centre).norm() < other->radius + 4 * other->blur) {
+        if ((p - other->centre).norm() < other->radius + 4 * other->widest_blur()) {
           clear *= 1 - other->value(p);
         }
       } else if ((p - other->centre).norm() < d) {
@@ -116,7 +116,7 @@ template <class Others>
 void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
                   const Others& others, const Eigen::Vector3d& vs, GrainWindow& window) {
   fill_window(
-      stack, centre, reach, vs, true,
+      stack, centre, Eigen::Vector3d::Constant(reach), vs, true,
       [&](const Eigen::Vector3d& p, double) { return 1 - others(p); }, window);
 }
 
@@ -303,6 +303,7 @@ class GrainLocator {
       g.start.centre = g.found_at;
       g.start.radius = radius_;
       g.start.blur = 0.6 * vs_.x();
+      g.start.blur_z = 0.6 * vs_.z();
       g.start.hole = hole_;
       grains_.push_back(g);
     }
@@ -339,13 +340,13 @@ class GrainLocator {
     };
   }
 
-  // A converged fit of the nominal size and a blur under the radius: a blur that wide
+  // A converged fit of the nominal size and blurs under the radius: a blur that wide
   // smears a grain into its neighbours, and such a fit explains something else (its next
   // window, three blurs wide, would be huge). Only such fits are started from again.
   bool shaped_like_a_grain(const GrainFit& f) const {
     return f.converged && f.sphere.centre.allFinite() &&
            std::abs(f.sphere.radius / radius_ - 1) <= o_.radius_tolerance &&
-           f.sphere.blur < radius_;
+           f.sphere.widest_blur() < radius_;
   }
 
   Neighbours neighbours(bool fitted_only) const {
@@ -365,11 +366,13 @@ class GrainLocator {
   GrainFit fit_one(std::size_t i, bool model_neighbours, const Neighbours& known,
                    GrainWindow& window, std::vector<const HoledSphere*>& near) const {
     const HoledSphere& s = grains_[i].start;
-    const double reach = s.radius + 3 * s.blur + 0.5 * vs_.maxCoeff();
+    // Three blurs beyond the radius, across the slices and along z.
+    const double margin = s.radius + 0.5 * vs_.maxCoeff();
+    const Eigen::Vector3d reach(margin + 3 * s.blur, margin + 3 * s.blur, margin + 3 * s.along_z());
     near.clear();
     known.grid.near(s.centre, 2, [&](std::size_t k) {
       const HoledSphere& other = grains_[known.ids[k]].start;
-      if (known.ids[k] != i && (other.centre - s.centre).norm() < 2 * reach + radius_) {
+      if (known.ids[k] != i && (other.centre - s.centre).norm() < 2 * reach.maxCoeff() + radius_) {
         near.push_back(&other);
       }
     });
@@ -461,14 +464,14 @@ class GrainLocator {
         known.grid.near(f.sphere.centre, 1, [&](std::size_t j) {
           HoledSphere s = grains_[ids[j]].start;
           s.radius += blur.shortfall;
-          const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.blur);
+          const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.widest_blur());
           if (j != k && (s.centre - f.sphere.centre).norm() < reach + reach_j) near.push_back(s);
         });
         const auto others = [&](const Eigen::Vector3d& p) {
           double sum = 0;
           for (const HoledSphere& s : near) {
             if (!blur.sampled) {
-              if ((p - s.centre).norm() < s.radius + 4 * s.blur) sum += s.value(p);
+              if ((p - s.centre).norm() < s.radius + 4 * s.widest_blur()) sum += s.value(p);
             } else if ((p - s.centre).norm() < s.radius + 5 * wide) {
               sum += blurred_grain_fraction(p, s, blur.across, blur.along_z);
             }

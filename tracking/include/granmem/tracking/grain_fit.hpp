@@ -21,7 +21,8 @@ struct GrainWindow {
 };
 
 // A blurred holed sphere fitted to a window by least squares (Ceres' TinySolver,
-// Levenberg-Marquardt, analytic Jacobian): centre, radius, blur, fluid and grain levels,
+// Levenberg-Marquardt, analytic Jacobian): centre, radius, the blurs across the slices and
+// along z, fluid and grain levels,
 // and the hole's axis when the grain has a hole. The scan is modelled as
 //   b - (b - g) (1 - (1 - M) clear)
 // so that neighbours seen in the window are part of the model instead of pulling the fit.
@@ -46,7 +47,7 @@ struct GrainFitOptions {
   int max_iterations = 40;
 };
 
-// Starts from `start` (its centre, radius, blur, axis and hole fraction).
+// Starts from `start` (its centre, radius, blurs, axis and hole fraction).
 GrainFit fit_grain(const GrainWindow& window, const HoledSphere& start,
                    const GrainFitOptions& options = {});
 

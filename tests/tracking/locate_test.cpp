@@ -143,11 +143,12 @@ TEST(Locate, DensePackingCoarserSlices) {
   const Detections d = locate(stack, o);
   const Eigen::Vector3d vs = *scan.options.voxel_size;
   EXPECT_EQ(d.length_unit, "mm");
-  // Radii in the stack's unit: a diameter of 1 mm.
-  double mean_radius = 0;
-  for (double r : d.radius)
-    mean_radius += r / double(d.size());
-  EXPECT_NEAR(mean_radius, 0.5, 0.05);
+  // Radii in the stack's unit: a diameter of 1 mm. The model fits' run 6 % small under
+  // this blur (0.47 mm); corrected by the axis refits' measure of it, within 1 %.
+  std::vector<double> radius = d.radius;
+  std::nth_element(radius.begin(), radius.begin() + long(radius.size() / 2), radius.end());
+  std::cout << "median radius " << radius[radius.size() / 2] << " mm\n";
+  EXPECT_NEAR(radius[radius.size() / 2], 0.5, 0.005);
   const LocateScore s = score_locate(d, truth, vs);
   report("d = 12, slices 1.5x coarser (errors in slices along z)", s);
   expect_accurate(s);

@@ -44,7 +44,10 @@ struct GrainFit {
 struct GrainFitOptions {
   bool fit_axis = true;         // with a hole: also the axis
   bool standard_errors = true;  // centre_sigma and axis_sigma (a fit that only starts another: no)
-  int max_iterations = 40;
+  // The blurs across and along z, the radius and the levels are correlated where the blur
+  // is wide: at 40, fits of 9-pixel grains under a blur along z of 0.4 R stopped short,
+  // and 1-3 % of the grains were lost.
+  int max_iterations = 80;
 };
 
 // Starts from `start` (its centre, radius, blurs, axis and hole fraction).

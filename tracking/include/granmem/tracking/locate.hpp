@@ -55,9 +55,12 @@ struct LocateSummary {
 // Grains the candidates missed are searched for in what the found ones leave unexplained.
 // Last, each hole's axis is refitted on the grain's inner voxels with a blur of its own
 // along z (hole_axis.hpp), and grains touching a neighbour through their hole are flagged
-// (hole_contacts.hpp). Works on its own copy of `stack` (normalised, illumination.hpp): move
-// a stack in that is not needed after. Positions, radii in the stack's unit when it has a
-// voxel size, else in voxels; anisotropic voxels handled throughout.
+// (hole_contacts.hpp); the refits, on the exactly blurred image, also measure how much the
+// model fits' radius runs small (the blurred surface's curvature), and the radii are
+// corrected by it (grains with holes). Works on its own copy of `stack` (normalised,
+// illumination.hpp): move a stack in that is not needed after. Positions, radii in the
+// stack's unit when it has a voxel size, else in voxels; anisotropic voxels handled
+// throughout.
 Detections locate(Stack stack, const LocateOptions& options, LocateSummary* summary = nullptr);
 
 // The grain diameter in voxels along x from "12", "12 vox" (or px), or a length ("1.5mm")

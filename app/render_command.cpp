@@ -72,7 +72,9 @@ void add_render(CLI::App& app) {
                   "--diameter-px and --slice-spacing-ratio)");
   cmd->add_option("--slice-spacing-ratio", args->slice_spacing_ratio, "slice spacing / pixel size")
       ->capture_default_str();
-  cmd->add_option("--margin", args->margin, "voxels around the grains' extent")
+  cmd->add_option("--margin", args->margin,
+                  "voxels around the grains' extent (a run with a container: below its lower "
+                  "corner, where every frame's stack starts, as a scanner's would)")
       ->capture_default_str();
   cmd->add_option("--bits", args->bits, "8 or 16")
       ->check(CLI::IsMember({8, 16}))

@@ -264,8 +264,9 @@ class Twin {
 
   // The experiment's steady state, measured with what the twin knows of its grains. Grains
   // known to be alike (the twin's are, without polydispersity) at the twin's radius: a
-  // scan's located radii come out ~5 % small from its blur and threshold, which would read
-  // as a packing 15 % looser and with no contacts. The packing's height with the twin's
+  // scan's located radii carry what is left of its blur's bias (a few % on coarse scans; 6 %
+  // before locate corrected it), which would read as a packing three times that looser and
+  // with fewer contacts. The packing's height with the twin's
   // grain count, the experiment's own: grains a scan misses would read as a looser packing.
   SteadyState measured_steady_state() const {
     return steady_state(experiment_, measured, {}, known_grains());

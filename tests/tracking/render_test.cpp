@@ -572,6 +572,44 @@ TEST_F(RenderRun, TheFrameByItsLabelDrawnAndWritten) {
   EXPECT_FALSE(std::filesystem::exists(o.out));
 }
 
+TEST_F(RenderRun, ARunsScansShareTheContainersFrame) {
+  // A run in a container: grain 1 stays, grain 2 rises, so the frames' grains span
+  // different heights. Each frame drawn alone, grain 1 sits at the same voxel in both, its
+  // first voxel `margin` voxels below the container's corner (a scanner does not move
+  // with the grains; a stack centred on each frame's grains moved by half the change).
+  Trajectories run;
+  run.header.length_unit = "mm";
+  run.header.id = {1, 2};
+  run.header.radius = {2.5, 2.5};
+  Box container;
+  container.edges = Eigen::Vector3d(20, 20, 30);
+  run.header.box = container;
+  for (auto [step, z] : {std::pair{10, 5.0}, std::pair{20, 17.3}}) {
+    Frame f = Frame::unknown(run.header);
+    f.step = step;
+    f.position << 5, 5, 2.5, 12, 6, z;
+    run.frames.push_back(f);
+  }
+  write_trajectories(path("run.h5"), run);
+  RenderRunOptions o;
+  o.run = path("run.h5");
+  o.render = o.render.without_artefacts();
+  o.voxel_size = "0.5,0.5,0.75mm";
+  std::vector<Eigen::Vector3d> first;
+  for (std::int64_t frame : {10, 20}) {
+    o.frame = frame;
+    o.out = path("scan" + std::to_string(frame) + ".tif");
+    o.truth = path("truth" + std::to_string(frame) + ".csv");
+    render_run(o);
+    const Table truth = read_csv(o.truth, {"x", "y", "z"}).table;
+    first.emplace_back(truth["x"].values[0], truth["y"].values[0], truth["z"].values[0]);
+  }
+  EXPECT_EQ(first[0], first[1]);
+  const double margin = o.render.margin;
+  EXPECT_NEAR(first[0].x(), 5 / 0.5 + margin, 1e-9);
+  EXPECT_NEAR(first[0].z(), 2.5 / 0.75 + margin, 1e-9);
+}
+
 // validate() before the run is read: the defaults (with a run and --out) pass; a bad
 // drawing option or --voxel-size is one line naming it, and nothing is written.
 TEST_F(RenderRun, ValidateNamesTheBadOptionBeforeTheRunIsRead) {

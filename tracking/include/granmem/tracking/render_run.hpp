@@ -10,7 +10,10 @@
 namespace granmem {
 
 // `granmem render` as one call: one frame of a trajectory store drawn as a laser-sheet scan
-// (render_scan), written as a multi-page TIFF, and its truth as CSV.
+// (render_scan), written as a multi-page TIFF, and its truth as CSV. A run with a container
+// (its box) is drawn in one frame for all its frames, the stack's first voxel `margin`
+// voxels below the container's lower corner, as a lab's scanner stays put; without, each
+// frame's stack is centred on its grains.
 struct RenderRunOptions {
   std::filesystem::path run;
   std::int64_t frame = 0;  // the frame's label (its step: cycle or scan)

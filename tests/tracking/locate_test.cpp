@@ -44,7 +44,7 @@ void report(const char* what, const LocateScore& s) {
 // What locate's standard errors say of its actual errors: per axis, the RMS error over the
 // RMS standard error, and the hole axis' median angle error over the median its standard
 // error predicts (a tilt of sigma in each of two directions: a Rayleigh angle, median
-// 1.177 sigma). The axes' are their size (1.07-1.30 measured); the centres' run 1.8-3.1x
+// 1.177 sigma). The axes' are their size (1.07-1.30 measured); the centres' run 1.6-3.5x
 // small, as the centres' errors are the model's misfit more than the camera's noise (with
 // 4x its variance they stay as they were, docs/BENCHMARKS.md "Standard errors"): bounded
 // so.

@@ -127,7 +127,13 @@ TEST(HoledSphere, OneBlurIsTheIsotropicModel) {
     const double expected =
         phi((g.radius - d.norm()) / g.blur) * (1 - phi((g.hole * g.radius - rho) / g.blur));
     EXPECT_NEAR(g.value(p), expected, 2e-7);
-    EXPECT_EQ(g.fraction(p, true).d_blur_z, 0.0);
+    // The one blur's derivative is the whole change, across and along z together.
+    const HoledSphere::Fraction f = g.fraction(p, true);
+    HoledSphere wider = g, narrower = g;
+    wider.blur += 1e-6;
+    narrower.blur -= 1e-6;
+    EXPECT_NEAR(f.d_blur, (wider.value(p) - narrower.value(p)) / 2e-6, 5e-6) << p.transpose();
+    EXPECT_EQ(f.d_blur_z, 0.0);
   }
 }
 

@@ -154,8 +154,8 @@ TEST(Locate, DensePackingCoarserSlices) {
   expect_accurate(s);
   // The blur along z, 2.1x that across, in the model: 0.018 / 0.022 voxel across measured
   // (0.027 / 0.030 with one blur alike in every direction).
-  EXPECT_LT(s.rms.x(), 0.025);
-  EXPECT_LT(s.rms.y(), 0.025);
+  EXPECT_LT(s.rms.x(), 0.026);
+  EXPECT_LT(s.rms.y(), 0.026);
   expect_edge_flags(d, truth, rendered, vs, 0.25);
   // Issue 5's bar, median <= 1 deg: the blur along z, 2.1x that across here, tilts a
   // model blurred alike everywhere by ~2.3 deg (median); the axis refit on the inner

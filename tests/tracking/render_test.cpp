@@ -601,8 +601,9 @@ TEST_F(RenderRun, ARunsScansShareTheContainersFrame) {
     o.out = path("scan" + std::to_string(frame) + ".tif");
     o.truth = path("truth" + std::to_string(frame) + ".csv");
     render_run(o);
-    const Table truth = read_csv(o.truth, {"x", "y", "z"}).table;
+    const Table truth = read_csv(o.truth, {"x", "y", "z", "edge"}).table;
     first.emplace_back(truth["x"].values[0], truth["y"].values[0], truth["z"].values[0]);
+    EXPECT_EQ(truth["edge"].values, std::vector<double>(2, 0.0)) << "a grain cut, frame " << frame;
   }
   EXPECT_EQ(first[0], first[1]);
   const double margin = o.render.margin;

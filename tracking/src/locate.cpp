@@ -451,8 +451,11 @@ class GrainLocator {
 
   // Refits the axes of every `step`-th grain, the neighbours seen through the model fits'
   // blur (before the sample) or through `blur` (after it).
+  // `rings`: of the neighbours' grid cells (a diameter wide) searched around each grain,
+  // enough for its window's reach plus a neighbour's radius and blurred rim.
   void refit_axes(const Neighbours& known, std::size_t step, const AxisBlur& blur,
-                  const HoleAxisOptions& axis_options, std::vector<HoleAxisFit>& refits) const {
+                  const HoleAxisOptions& axis_options, std::vector<HoleAxisFit>& refits,
+                  int rings = 1) const {
     const std::vector<std::size_t>& ids = known.ids;
 #pragma omp parallel
     {
@@ -466,7 +469,7 @@ class GrainLocator {
         const double reach = axis_options.within * (f.sphere.radius + blur.shortfall);
         const double wide = std::max(blur.across, blur.along_z);
         near.clear();
-        known.grid.near(f.sphere.centre, 1, [&](std::size_t j) {
+        known.grid.near(f.sphere.centre, rings, [&](std::size_t j) {
           HoledSphere s = grains_[ids[j]].start;
           s.radius += blur.shortfall;
           const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.widest_blur());
@@ -495,9 +498,11 @@ class GrainLocator {
   // partial volumes bias it on sharp scans) less the model fit's.
   double radius_shortfall(const Neighbours& known, std::size_t stride, const AxisBlur& blur,
                           HoleAxisOptions whole) const {
-    whole.within = 1 + (3 * std::max(blur.across, blur.along_z) + 0.5 * vs_.maxCoeff()) / radius_;
+    const double wide = std::max(blur.across, blur.along_z);
+    whole.within = 1 + (3 * wide + 0.5 * vs_.maxCoeff()) / radius_;
+    const double reach = whole.within * radius_ + radius_ + 5 * wide;
     std::vector<HoleAxisFit> refits(known.ids.size());
-    refit_axes(known, stride, blur, whole, refits);
+    refit_axes(known, stride, blur, whole, refits, int(std::ceil(reach / diameter_)));
     std::vector<double> shortfall;
     for (std::size_t k = 0; k < known.ids.size(); k += stride) {
       if (refits[k].converged)

@@ -75,23 +75,22 @@ namespace {
 
 // A run with a container: its scans share one frame, as a lab's scanner stays where it is
 // while the grains move. The stack's first voxel `margin` voxels below the container's lower
-// corner (the grains' own stack's along an axis where a grain reaches further out), its far
-// side where the grains' own stack ends; without, each frame's stack is centred on its
-// grains and the frames' origins differ by up to half a voxel and by the packing's changes
-// of height.
+// corner (a grain further out is cut by the stack's border, as by a scanner's field of
+// view), its far side where the grains' own stack ends; without, each frame's stack is
+// centred on its grains and the frames' origins differ by up to half a voxel and by the
+// packing's changes of height.
 void fix_to_the_container(const std::vector<RenderedGrain>& grains, const RunHeader& h,
                           RenderOptions& o) {
   if (!h.box || o.origin || o.size) return;
   const ScanGeometry own = scan_geometry(grains, o);
   const Eigen::Vector3d& vs = own.voxel_size;
-  Eigen::Vector3d origin = h.box->lower - o.margin * vs;
-  for (const RenderedGrain& g : grains)
-    for (int a = 0; a < 3; ++a)
-      if (g.centre[a] - g.radius < origin[a]) origin[a] = own.origin[a];
+  const Eigen::Vector3d origin = h.box->lower - o.margin * vs;
   const Eigen::Vector3d last =
       own.origin +
       Eigen::Vector3d(double(own.nx - 1), double(own.ny - 1), double(own.nz - 1)).cwiseProduct(vs);
-  const Eigen::Vector3d count = ((last - origin).cwiseQuotient(vs).array() + 1).ceil().matrix();
+  // Voxels from the origin to the last (1e-9: a whole number of voxels not one more).
+  const Eigen::Vector3d count =
+      ((last - origin).cwiseQuotient(vs).array() + 1 - 1e-9).ceil().max(1.0).matrix();
   o.voxel_size = vs;
   o.origin = origin;
   o.size = {std::int64_t(count.x()), std::int64_t(count.y()), std::int64_t(count.z())};

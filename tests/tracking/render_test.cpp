@@ -611,6 +611,36 @@ TEST_F(RenderRun, ARunsScansShareTheContainersFrame) {
   EXPECT_NEAR(first[0].z(), 2.5 / 0.75 + margin, 1e-9);
 }
 
+TEST_F(RenderRun, ARunsFramesShareOneVoxelSize) {
+  // Grains of 2.5, 3 and 3.5 mm; the last has no position in frame 20. Each frame drawn
+  // at the run's median radius (3 mm: 0.5 mm pixels at 12 pixels a diameter), not at its
+  // own grains' (frame 20's median is 2.75 mm).
+  Trajectories run;
+  run.header.length_unit = "mm";
+  run.header.id = {1, 2, 3};
+  run.header.radius = {2.5, 3, 3.5};
+  for (std::int64_t step : {10, 20}) {
+    Frame f = Frame::unknown(run.header);
+    f.step = step;
+    f.position << 5, 5, 5, 12, 5, 5, 20, 5, 5;
+    if (step == 20) f.position.row(2).setConstant(std::nan(""));
+    run.frames.push_back(f);
+  }
+  write_trajectories(path("run.h5"), run);
+  RenderRunOptions o;
+  o.run = path("run.h5");
+  o.render = o.render.without_artefacts();
+  o.render.diameter_px = 12;
+  o.render.slice_spacing_ratio = 1.5;
+  for (std::int64_t frame : {10, 20}) {
+    o.frame = frame;
+    o.out = path("scan" + std::to_string(frame) + ".tif");
+    const RenderSummary s = render_run(o);
+    EXPECT_NEAR(s.voxel_size.x(), 0.5, 1e-12) << "frame " << frame;
+    EXPECT_NEAR(s.voxel_size.z(), 0.75, 1e-12) << "frame " << frame;
+  }
+}
+
 // validate() before the run is read: the defaults (with a run and --out) pass; a bad
 // drawing option or --voxel-size is one line naming it, and nothing is written.
 TEST_F(RenderRun, ValidateNamesTheBadOptionBeforeTheRunIsRead) {

@@ -232,6 +232,11 @@ double RenderOptions::grain() const {
   return polarity == Polarity::dark_grains ? 0.15 : 0.7;
 }
 
+Eigen::Vector3d voxel_size_for(double median_radius, const RenderOptions& options) {
+  const double pixel = 2 * median_radius / options.diameter_px;
+  return Eigen::Vector3d(pixel, pixel, pixel * options.slice_spacing_ratio);
+}
+
 ScanGeometry scan_geometry(const std::vector<RenderedGrain>& grains, const RenderOptions& options) {
   options.validate();
   check_grains(grains);
@@ -243,8 +248,7 @@ ScanGeometry scan_geometry(const std::vector<RenderedGrain>& grains, const Rende
     std::vector<double> radii;
     for (const RenderedGrain& grain : grains)
       radii.push_back(grain.radius);
-    const double pixel = 2 * median(radii) / options.diameter_px;
-    g.voxel_size = Eigen::Vector3d(pixel, pixel, pixel * options.slice_spacing_ratio);
+    g.voxel_size = voxel_size_for(median(radii), options);
   }
   if (options.origin && options.size) {
     g.origin = *options.origin;

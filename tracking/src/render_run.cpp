@@ -1,5 +1,6 @@
 #include "granmem/tracking/render_run.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <optional>
 #include <sstream>
@@ -7,6 +8,7 @@
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
 #include "granmem/tracking/stack.hpp"
@@ -112,6 +114,11 @@ RenderSummary render_run(const RenderRunOptions& options) {
     throw Error("--frame " + std::to_string(options.frame) + ": " + options.run.string() +
                 " has no grain with a position in that frame; nothing to draw");
   }
+  // Every frame of a run at one voxel size: from the run's grains, not this frame's.
+  std::vector<double> radii;
+  for (double r : h.radius)
+    if (std::isfinite(r) && r > 0) radii.push_back(r);
+  if (!o.voxel_size && !radii.empty()) o.voxel_size = voxel_size_for(median(radii), o);
   fix_to_the_container(grains, h, o);
   // Both places are checked before the drawing, which takes a while.
   AtomicFile{options.out};

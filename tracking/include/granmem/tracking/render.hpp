@@ -132,6 +132,10 @@ struct ScanGeometry {
   }
 };
 
+// The voxel size that draws the median grain `diameter_px` pixels across, the slices
+// `slice_spacing_ratio` pixels apart.
+Eigen::Vector3d voxel_size_for(double median_radius, const RenderOptions& options);
+
 // Throws Error naming the bad option or grain.
 ScanGeometry scan_geometry(const std::vector<RenderedGrain>& grains, const RenderOptions& options);
 

@@ -22,7 +22,8 @@ struct RenderRunOptions {
   // How to draw (its length_unit and frame are set from the run and `frame`).
   RenderOptions render;
   // The voxel size "X[,Y,Z]<unit>" (--voxel-size), converted to the run's length unit;
-  // empty: render.voxel_size, or from diameter_px.
+  // empty: render.voxel_size, or from diameter_px and the run's median radius (every frame
+  // alike).
   std::string voxel_size;
   // The options as the user gave them, in the truth table's comment lines.
   std::map<std::string, std::string> parameters;

@@ -42,6 +42,11 @@ double mean_of_smallest(std::vector<double> values, std::size_t count) {
   return sum / double(count);
 }
 
+double end_layer_mean(std::vector<double> surfaces, double face, double radius) {
+  const double grains = std::max(1.0, std::round(face / (16 * radius * radius)));
+  return mean_of_smallest(std::move(surfaces), std::size_t(grains));
+}
+
 double bootstrap_standard_error(const std::vector<double>& values, std::size_t resamples,
                                 Random& random) {
   std::vector<double> v;

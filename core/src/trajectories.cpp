@@ -112,14 +112,11 @@ PackingSurfaces first_frame_surfaces(const Trajectories& run) {
   return s;
 }
 
-// Where one side of the packing ends: the mean over a quarter of a layer's grains (the
-// packing's face, its extent across the other two axes, over 4 d^2) of the surfaces
-// nearest that side, as the packing's height is measured.
+// Where one side of the packing ends (its face: the extent across the other two axes), as
+// the packing's height is measured.
 double end_layer(const PackingSurfaces& s, int axis, const std::vector<double>& surfaces) {
   const Eigen::Vector3d span = s.highest - s.lowest;
-  const double face = span[(axis + 1) % 3] * span[(axis + 2) % 3];
-  const double count = std::max(1.0, std::round(face / (16 * s.radius * s.radius)));
-  return mean_of_smallest(surfaces, std::size_t(count));
+  return end_layer_mean(surfaces, span[(axis + 1) % 3] * span[(axis + 2) % 3], s.radius);
 }
 
 }  // namespace

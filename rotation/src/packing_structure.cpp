@@ -121,11 +121,8 @@ double height_packing_fraction(const Vectors3& position, const std::vector<doubl
   }
   if (bottoms.empty()) return std::nan("");
   if (grains) volume *= double(*grains) / double(bottoms.size());
-  // A quarter of a layer (a layer: the cross-section over d^2) at each end.
-  const auto end_grains = std::clamp<std::size_t>(
-      std::size_t(std::lround(cross_section / (16 * typical * typical))), 1, bottoms.size());
-  const double bottom = mean_of_smallest(std::move(bottoms), end_grains);
-  const double top = -mean_of_smallest(std::move(tops), end_grains);
+  const double bottom = end_layer_mean(std::move(bottoms), cross_section, typical);
+  const double top = -end_layer_mean(std::move(tops), cross_section, typical);
   return top > bottom ? volume / (cross_section * (top - bottom)) : std::nan("");
 }
 

@@ -300,5 +300,12 @@ TEST(MeanOfSmallest, AveragesTheSmallestValuesWhateverTheirOrder) {
   EXPECT_TRUE(std::isnan(mean_of_smallest({1, 2}, 0)));
 }
 
+TEST(EndLayerMean, AveragesAQuarterOfALayersGrains) {
+  // A face of 12 d^2 holds 12 grains a layer: the 3 nearest; a tiny face still one.
+  const double r = 0.5;
+  EXPECT_DOUBLE_EQ(end_layer_mean({7, 3, 1, 9, 2, 8}, 12 * 4 * r * r, r), 2);
+  EXPECT_DOUBLE_EQ(end_layer_mean({7, 3, 1, 9}, 0.01, r), 1);
+}
+
 }  // namespace
 }  // namespace granmem

@@ -33,6 +33,11 @@ double median(std::vector<double> values);
 // The mean of the `count` smallest values (all of them if fewer; NaN if none), in O(n):
 // a packing's end layer, less noisy than its one extreme grain.
 double mean_of_smallest(std::vector<double> values, std::size_t count);
+// Where a packing ends at a wall, floor or lid: the mean of the smallest `surfaces` (the
+// grains' surfaces facing it, signed so that the nearest are the smallest) over a quarter
+// of a layer's grains, the face's area over 4 d^2 for grains of radius `radius` (at least
+// one).
+double end_layer_mean(std::vector<double> surfaces, double face, double radius);
 
 // The 97.5 % point of Student's t with `dof` degrees of freedom (Cornish-Fisher expansion
 // about the normal's 1.96; within 0.2 % for dof >= 3; the normal's for dof <= 0): a 95 %

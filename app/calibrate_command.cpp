@@ -24,12 +24,12 @@ std::vector<std::string> parse_names(const std::string& text) {
 
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
-    std::string experiment, out, mu_s = "0.03,0.05,0.08,0.12,0.2,0.3,0.5", window, noise = "auto",
-                                 wall_distance = "0", preparation = "each", summaries = "pooled",
-                                 observables = "displacements", only, fit = "mu_s";
+    std::string experiment, out, mu_s, window, noise = "auto", wall_distance = "0",
+                                               preparation = "each", summaries = "pooled",
+                                               observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
-    int threads = 0, degree = 2, replicas = 2, refine = 0;
+    int threads = 0, degree = 2, replicas = 0, refine = 0;
     std::string axis_noise = "auto";
   };
   auto args = std::make_shared<Args>();
@@ -41,8 +41,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "output folder")->required();
-  cmd->add_option("--mu-s", args->mu_s, "the frictions simulated, comma list")
-      ->capture_default_str();
+  CLI::Option* mu_s =
+      cmd->add_option("--mu-s", args->mu_s,
+                      "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4, "
+                      "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
   cmd->add_option("--window", args->window,
                   "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
                   "experiment's last 10; steady-state: auto, the longest window ending there "
@@ -69,8 +71,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->capture_default_str();
   cmd->add_option("--replicas", args->replicas,
                   "packings per friction (seeds seed, seed+1, ...): their scatter is the "
-                  "realization noise the interval includes")
-      ->capture_default_str()
+                  "realization noise the interval includes; default steady-state 3, "
+                  "displacements 2")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
@@ -125,7 +127,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                         ->group("Simulated twin (or the config's [simulate])");
   }
 
-  cmd->callback([args, given, simulate, cmd] {
+  cmd->callback([args, given, simulate, mu_s] {
     CalibrateOptions o;
     // The twin: simulate's defaults, then the config's [simulate], then calibrate's own.
     o.twin = simulate.args->value;
@@ -137,7 +139,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     }
     o.experiment = args->experiment;
     o.out = args->out;
-    o.mu_s = parse_frictions(args->mu_s, "--mu-s");
+    if (mu_s->count() > 0) o.mu_s = parse_frictions(args->mu_s, "--mu-s");
     if (args->fit == "mu_s,mu_r") o.mu_r = parse_frictions(o.twin.at("mu-r"), "--mu-r");
     o.observables = args->observables == "steady-state" ? CalibrationObservables::steady_state
                                                         : CalibrationObservables::displacements;

@@ -834,7 +834,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   report << "\n" << observables_line(twin, fit.names, &fit.resolution);
   report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
          << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
-         << " in ln mu_s on " << fit.cross_validations << " runs\n";
+         << " in ln mu_s at the fit from " << fit.cross_validations << " runs\n";
   report << left_out.str();
   for (const std::string& note : written.notes)
     report << "  note: " << note << "\n";
@@ -901,8 +901,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
          << " simulations\n"
          << observables_line(twin, fit.names, nullptr) << "  chi2 " << fit.chi2 << " for "
          << fit.dof << " dof; cross-validated " << fit.cross_validated_sigma[0] << " (mu_s), "
-         << fit.cross_validated_sigma[1] << " (mu_r) in ln on " << fit.cross_validations
-         << " runs\n"
+         << fit.cross_validated_sigma[1] << " (mu_r) in ln at the fit from "
+         << fit.cross_validations << " runs\n"
          << left_out.str() << "wrote " << (o.out / "summary.json").string() << ", "
          << figure.size() + compared.written.size() << " figure files\n";
 }
@@ -1043,6 +1043,17 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
 
 }  // namespace
 
+CalibrateOptions CalibrateOptions::with_default_design() const {
+  const bool steady = observables == CalibrationObservables::steady_state;
+  CalibrateOptions o = *this;
+  if (o.mu_s.empty()) {
+    o.mu_s = steady ? std::vector<double>{0.05, 0.1, 0.2, 0.4}
+                    : std::vector<double>{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5};
+  }
+  if (o.replicas == 0) o.replicas = steady ? 3 : 2;
+  return o;
+}
+
 void CalibrateOptions::validate() const {
   check_frictions(mu_s, "--mu-s");
   if (joint()) check_frictions(mu_r, "--mu-r");
@@ -1101,7 +1112,8 @@ void CalibrateOptions::set_window(const std::string& text, const std::string& op
   if (!auto_window) window = parse_int_range(text, option);
 }
 
-CalibrateSummary calibrate(const CalibrateOptions& options) {
+CalibrateSummary calibrate(const CalibrateOptions& given) {
+  const CalibrateOptions options = given.with_default_design();
   options.validate();
   const TrajectoryReader experiment(options.experiment);
   Twin twin(options, experiment);  // every setting checked before any output

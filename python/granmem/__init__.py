@@ -316,14 +316,15 @@ def _frictions(value):
     return ",".join(repr(float(m)) for m in value)
 
 
-def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_r=None,
+def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
-              summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=2,
+              summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
               refine=0, axis_noise="auto", deposit="each", fit_only=False, parallel=0, progress=None,
               **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
-    ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
+    ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings (``None``:
+    steady-state 0.05, 0.1, 0.2, 0.4 on 3, displacements 0.03-0.5 on 2), in the
     folder ``out`` (finished runs are reused when called again), and the friction fitted
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
     (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
@@ -348,7 +349,7 @@ def calibrate(experiment, out, mu_s=(0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5), mu_
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
-                              int(degree), int(replicas), int(refine),
+                              int(degree), None if replicas is None else int(replicas), int(refine),
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit,

@@ -747,19 +747,21 @@ py::dict readout_py(const std::vector<std::filesystem::path>& states,
 // ---------------------------------------------------------------------------- calibrate
 
 py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesystem::path& out,
-                      const std::string& mu_s, const std::optional<std::string>& mu_r,
-                      const std::string& observables, const std::vector<std::string>& only,
+                      const std::optional<std::string>& mu_s,
+                      const std::optional<std::string>& mu_r, const std::string& observables,
+                      const std::vector<std::string>& only,
                       const std::optional<std::string>& window, const std::string& noise,
                       const std::string& summaries, const std::string& wall_distance,
-                      bool subtract_drift, int degree, int replicas, int refine,
-                      const std::string& axis_noise, const std::string& deposit, bool fit_only,
-                      int parallel, const py::dict& twin, const py::object& progress) {
+                      bool subtract_drift, int degree, const std::optional<int>& replicas,
+                      int refine, const std::string& axis_noise, const std::string& deposit,
+                      bool fit_only, int parallel, const py::dict& twin,
+                      const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
   o.out = out;
   set_settings(twin, o.twin, is_twin_setting,
                "calibrate: '%' is not a setting of the twin (see granmem calibrate --help)");
-  o.mu_s = parse_frictions(mu_s, "mu_s");
+  if (mu_s) o.mu_s = parse_frictions(*mu_s, "mu_s");
   if (mu_r) o.mu_r = parse_frictions(*mu_r, "mu_r");
   if (observables != "displacements" && observables != "steady-state") {
     throw Error("observables '" + observables + "': expected displacements or steady-state");
@@ -776,7 +778,10 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.wall_distance = parse_si(wall_distance, Dimension::length, "m", "wall_distance");
   o.subtract_drift = subtract_drift;
   o.degree = degree;
-  o.replicas = replicas;
+  if (replicas) {
+    if (*replicas < 1) throw Error("replicas: at least one packing");
+    o.replicas = *replicas;
+  }
   o.refine = refine;
   o.axis_noise = parse_axis_noise(axis_noise, "axis_noise");
   if (deposit != "each" && deposit != "shared") {
@@ -907,12 +912,12 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("radius") = py::none());
   m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
-  m.def("calibrate", &calibrate_py, py::arg("experiment"), py::arg("out"), py::arg("mu_s"),
-        py::arg("mu_r") = py::none(), py::arg("observables") = "displacements",
-        py::arg("only") = std::vector<std::string>{}, py::arg("window") = py::none(),
-        py::arg("noise") = "auto", py::arg("summaries") = "pooled", py::arg("wall_distance") = "0",
-        py::arg("subtract_drift") = true, py::arg("degree") = CalibrateOptions{}.degree,
-        py::arg("replicas") = CalibrateOptions{}.replicas,
+  m.def("calibrate", &calibrate_py, py::arg("experiment"), py::arg("out"),
+        py::arg("mu_s") = py::none(), py::arg("mu_r") = py::none(),
+        py::arg("observables") = "displacements", py::arg("only") = std::vector<std::string>{},
+        py::arg("window") = py::none(), py::arg("noise") = "auto", py::arg("summaries") = "pooled",
+        py::arg("wall_distance") = "0", py::arg("subtract_drift") = true,
+        py::arg("degree") = CalibrateOptions{}.degree, py::arg("replicas") = py::none(),
         py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = "auto",
         py::arg("deposit") = "each", py::arg("fit_only") = false, py::arg("parallel") = 0,
         py::arg("twin") = py::dict(), py::arg("progress") = py::none());

@@ -9,9 +9,9 @@ import granmem
 # A tiny pseudo-experiment and its twin's protocol: 60 grains in a 2 cm box, 3 cycles.
 TWIN = dict(grains=60, box="2cm", lid_mass="0.2kg", amplitude="5%", period="0.1s")
 TWIN_FLAGS = ["--grains", "60", "--box", "2cm", "--lid-mass", "0.2kg", "--amplitude", "5%",
-              "--period", "0.1s"]
+              "--period", "0.1s", "--replicas", "2"]
 FIT = dict(mu_s=[0.05, 0.1, 0.2, 0.4], window=(2, 3), observables="steady-state",
-           fit_only=True, parallel=2)
+           fit_only=True, parallel=2, replicas=2)
 
 
 @pytest.fixture

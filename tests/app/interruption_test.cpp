@@ -219,6 +219,7 @@ TEST_F(Interruption, AKilledCalibrationReusesItsFinishedRunsAndFitsTheSame) {
     std::vector<std::string> a{
         "calibrate",        "--experiment",  "exp.h5",       "--out",      out,        "--mu-s",
         "0.05,0.1,0.2,0.4", "--observables", "steady-state", "--fit-only", "--window", "1:2"};
+    a.insert(a.end(), {"--replicas", "2"});
     a.insert(a.end(), twin.begin(), twin.end());
     return a;
   };

@@ -32,7 +32,8 @@ struct CalibrateOptions {
   std::filesystem::path experiment;  // the experiment's trajectory store
   std::filesystem::path out;         // summary, tables, figures; the twin's runs in out/runs
   RunSettings twin = default_simulate_settings();  // the twin's `simulate` settings
-  std::vector<double> mu_s{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5};  // frictions simulated
+  // The frictions simulated; empty: the observables' own design (with_default_design()).
+  std::vector<double> mu_s;
   // The rolling frictions simulated in a joint fit of mu_s and mu_r (every mu_s x mu_r);
   // empty: mu_s alone, at the twin's own mu_r.
   std::vector<double> mu_r;
@@ -57,7 +58,7 @@ struct CalibrateOptions {
   std::optional<double> axis_noise;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
   int degree = 2;              // of the polynomial in ln mu_s through the runs
-  int replicas = 2;            // packings per friction (seeds seed, seed + 1, ...)
+  int replicas = 0;            // packings per friction (seeds seed, seed + 1, ...); 0: the design's
   TwinPreparation preparation = TwinPreparation::each;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
@@ -75,6 +76,10 @@ struct CalibrateOptions {
   const std::atomic<bool>* stop = nullptr;
 
   bool joint() const { return !mu_r.empty(); }
+  // These options with the twin's design where they leave it: for the steady state 3
+  // packings x mu_s 0.05, 0.1, 0.2, 0.4 (12 runs: the design docs/CALIBRATION.md measures
+  // on pseudo-experiments), for the displacements 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
+  CalibrateOptions with_default_design() const;
   // --window's text: FIRST:LAST, or auto (`option` names it in an error).
   void set_window(const std::string& text, const std::string& option);
   // Checks the options against each other (Error naming the command line's option);

@@ -24,9 +24,15 @@ struct ObservableFitOptions {
   // Each observable across the runs as a polynomial of this degree in ln(mu_s).
   int degree = 2;
   // With runs of two seeds or more: each run at an interior friction, taken as the
-  // experiment, is fitted with the other seeds' runs; the RMS of ln(fitted / true) is how
-  // far one packing moves the fit, and the interval takes it when it is the larger error.
+  // experiment, is fitted with the other seeds' runs; how far ln(fitted / true) falls from
+  // zero is how far one packing moves the fit, and the interval takes it when it is the
+  // larger error.
   bool cross_validate = true;
+  // How those errors carry to the experiment's friction: as the RMS of each error over
+  // the error the trend predicts at its friction (the Fisher error of the observables'
+  // slope against their scatter), times the predicted error at the fit (true); or as
+  // their plain RMS, wherever the runs are (false).
+  bool cross_validation_by_friction = true;
 };
 
 struct ObservableFit {
@@ -36,7 +42,7 @@ struct ObservableFit {
   double chi2 = 0, dof = 0;   // at the fit; dof = observables - 1
   double error_scale = 1;     // sqrt(chi2 / dof) when above 1
   double gls_sigma = 0;       // the GLS fit's own standard error of ln(mu_s), widened on a misfit
-  double cross_validated_sigma = 0;
+  double cross_validated_sigma = 0;  // one packing's error in ln(mu_s) at the fit, held out
   std::size_t cross_validations = 0;
   std::vector<double> scatter;     // per observable: the runs' scatter about the trend
   std::vector<double> resolution;  // per observable: its own error in ln(mu_s) at the fit

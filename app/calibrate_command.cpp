@@ -41,7 +41,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "output folder")->required();
-  CLI::Option* mu_s =
+  CLI::Option* mu_s_option =
       cmd->add_option("--mu-s", args->mu_s,
                       "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4, "
                       "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
@@ -127,7 +127,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                         ->group("Simulated twin (or the config's [simulate])");
   }
 
-  cmd->callback([args, given, simulate, mu_s] {
+  cmd->callback([args, given, simulate, mu_s_option] {
     CalibrateOptions o;
     // The twin: simulate's defaults, then the config's [simulate], then calibrate's own.
     o.twin = simulate.args->value;
@@ -139,7 +139,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     }
     o.experiment = args->experiment;
     o.out = args->out;
-    if (mu_s->count() > 0) o.mu_s = parse_frictions(args->mu_s, "--mu-s");
+    if (mu_s_option->count() > 0) o.mu_s = parse_frictions(args->mu_s, "--mu-s");
     if (args->fit == "mu_s,mu_r") o.mu_r = parse_frictions(o.twin.at("mu-r"), "--mu-r");
     o.observables = args->observables == "steady-state" ? CalibrationObservables::steady_state
                                                         : CalibrationObservables::displacements;

@@ -323,8 +323,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
               **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
-    ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings (``None``:
-    steady-state 0.05, 0.1, 0.2, 0.4 on 3, displacements 0.03-0.5 on 2), in the
+    ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
     folder ``out`` (finished runs are reused when called again), and the friction fitted
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
     (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
@@ -338,6 +337,10 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     "auto": the scans' own RMS axis standard error where the store has them, else none.
     ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors
     ("auto" too where the store has them, else fits it on scans).
+
+    ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
+    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs), for "displacements"
+    0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5 on 2.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``

@@ -58,7 +58,9 @@ struct CalibrateOptions {
   std::optional<double> axis_noise;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
   int degree = 2;              // of the polynomial in ln mu_s through the runs
-  int replicas = 0;            // packings per friction (seeds seed, seed + 1, ...); 0: the design's
+  // Packings per friction (seeds seed, seed + 1, ...); 0: the observables' own design (so a
+  // caller's 0 is not refused, it is the default).
+  int replicas = 0;
   TwinPreparation preparation = TwinPreparation::each;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each

@@ -96,14 +96,16 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "displacements: the distribution of end-of-cycle displacements (--summaries); "
                   "steady-state: the window means of the rotation, the packing fraction from "
                   "the packing's height and in its bulk, the coordination, all from positions, "
-                  "and the wall force where the experiment has it (docs/CALIBRATION.md)")
+                  "and the wall force at full compression and at the cycle's end where the "
+                  "experiment has them (docs/CALIBRATION.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"displacements", "steady-state"}));
   cmd->add_option("--only", args->only,
                   "steady-state: fit only these observables, comma list (rot_disp, "
                   "bulk_packing_fraction, coordination, height_packing_fraction, "
-                  "packing_fraction, wall_force_full_compression); default all the experiment "
-                  "has, the lid's packing_fraction left out where the height's is there");
+                  "packing_fraction, wall_force_full_compression, wall_force_unloaded); "
+                  "default all the experiment has, the lid's packing_fraction left out where "
+                  "the height's is there");
   cmd->add_option("--fit", args->fit,
                   "the frictions fitted: mu_s, or mu_s,mu_r jointly (steady-state observables; "
                   "--mu-r is then the list of rolling frictions simulated, e.g. "

@@ -18,7 +18,7 @@ import re
 import sys
 
 OBSERVABLES = ["rot_disp", "bulk_packing_fraction", "coordination",
-               "height_packing_fraction", "wall_force_full_compression"]
+               "height_packing_fraction", "wall_force_full_compression", "wall_force_unloaded"]
 
 
 def cases(study):

@@ -20,8 +20,9 @@ observables how well one packing pins ln mu_s:
   scripts/observable_information.py out/early3k --window 3:8 \
       --out docs/data/friction/observable_information_3000.csv
 
-Where the runs have them, the lid's packing fraction and the wall force (the apparatus'
-observables, not a scan's) are fitted with the current four as well.
+Where the runs have them, the lid's packing fraction and the wall force at full compression
+(the apparatus' observables, not a scan's) are fitted with the current four as well, and,
+where the study's fits measured it, the wall force at each cycle's end (unloaded).
 
 Candidates (end-of-cycle frames of the window, grains > 1 d from the packing's extent for
 the structure; translations as `granmem analyze` measures them, drift removed):
@@ -181,6 +182,13 @@ def main():
     apparatus = [n for n in ("packing_fraction", "wall_force_full_compression") if n in table]
     if apparatus and table[apparatus].notna().all().all():
         sets["current + lid height and wall force"] = CURRENT + apparatus
+        # The wall's force at each cycle's end (the wall back at its start), where the fits
+        # measured it (calibrate since 2026-11-26).
+        if "wall_force_unloaded" in table and table["wall_force_unloaded"].notna().all():
+            sets["wall_force_unloaded"] = ["wall_force_unloaded"]
+            sets["current + wall force unloaded"] = CURRENT + ["wall_force_unloaded"]
+            sets["current + lid height and both wall forces"] = (
+                CURRENT + apparatus + ["wall_force_unloaded"])
     twin = table[table["kind"] == "mu_s"]
     grid = twin[twin["seed"].isin([1, 2, 3]) & twin["mu_s"].isin(design)]
     added = twin[~twin["seed"].isin([1, 2, 3])]

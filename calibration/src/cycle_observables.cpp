@@ -213,7 +213,8 @@ std::string steady_state_label(const std::string& name) {
       {"coordination", "coordination number (positions)"},
       {"height_packing_fraction", "packing fraction (positions' height)"},
       {"packing_fraction", "packing fraction (lid height)"},
-      {"wall_force_full_compression", "wall force at full compression (N)"}};
+      {"wall_force_full_compression", "wall force at full compression (N)"},
+      {"wall_force_unloaded", "wall force at the cycle's end (N)"}};
   const auto it = labels.find(name);
   return it == labels.end() ? name : it->second;
 }
@@ -271,8 +272,14 @@ ObservableSeries observable_series(const TrajectoryReader& run, const CycleObser
     s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
   }
   add_structure_series(s, run, structure, known, cycles);
-  for (const char* name : {"packing_fraction", "wall_force_full_compression"}) {
-    const auto it = run.observables().find(name);
+  // The store's own, under the names the fit knows them by: the wall force at the end of
+  // each cycle is the packing's lateral stress with the wall back at its start.
+  const std::pair<const char*, const char*> stored[] = {
+      {"packing_fraction", "packing_fraction"},
+      {"wall_force_full_compression", "wall_force_full_compression"},
+      {"wall_force", "wall_force_unloaded"}};
+  for (const auto& [in_store, name] : stored) {
+    const auto it = run.observables().find(in_store);
     if (it != run.observables().end()) {
       s.entries.push_back({name, it->second.step, it->second.value, false});
     }

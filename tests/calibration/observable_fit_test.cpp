@@ -232,9 +232,12 @@ struct FitCase {
 };
 
 std::vector<FitCase> dem_fit_cases() {
-  const std::vector<std::string> observables{"rot_disp", "bulk_packing_fraction", "coordination",
+  const std::vector<std::string> observables{"rot_disp",
+                                             "bulk_packing_fraction",
+                                             "coordination",
                                              "height_packing_fraction",
-                                             "wall_force_full_compression"};
+                                             "wall_force_full_compression",
+                                             "wall_force_unloaded"};
   std::vector<std::string> columns{"case", "role", "mu_s_true", "mu_s", "seed"};
   columns.insert(columns.end(), observables.begin(), observables.end());
   const Table t =

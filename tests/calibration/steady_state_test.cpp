@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "checks.hpp"
 #include "granmem/calibration/comparison.hpp"
@@ -39,12 +40,16 @@ Trajectories cubic_run() {
       f.axis.row(k) << 0, -std::sin(kTurn * c), std::cos(kTurn * c);
     }
     run.frames.push_back(f);
-    for (const char* name : {"wall_force_full_compression", "packing_fraction"}) {
+    // At full compression, at the cycle's end (unloaded), and the lid's packing fraction.
+    const std::pair<const char*, double> stored[] = {{"wall_force_full_compression", 10.0 * c},
+                                                     {"wall_force", 2.0 - 0.1 * c},
+                                                     {"packing_fraction", 0.5 + 0.01 * c}};
+    for (const auto& [name, value] : stored) {
       Observable& o = run.observables[name];
       o.unit = name[0] == 'w' ? "N" : "1";
       o.step.push_back(c);
       o.time.push_back(c);
-      o.value.push_back(name[0] == 'w' ? 10.0 * c : 0.5 + 0.01 * c);
+      o.value.push_back(value);
     }
   }
   return run;
@@ -58,20 +63,23 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   ObservableOptions o;
   o.window = {3, 4};
   const SteadyState s = steady_state(run, cycle_observables(run, o));
-  EXPECT_EQ(s.names, (std::vector<std::string>{"rot_disp", "bulk_packing_fraction", "coordination",
-                                               "height_packing_fraction", "packing_fraction",
-                                               "wall_force_full_compression"}));
+  EXPECT_EQ(s.names,
+            (std::vector<std::string>{"rot_disp", "bulk_packing_fraction", "coordination",
+                                      "height_packing_fraction", "packing_fraction",
+                                      "wall_force_full_compression", "wall_force_unloaded"}));
   EXPECT_NEAR(s["rot_disp"], kTurn / 2, 1e-12);  // angle x d/2, in diameters
   EXPECT_NEAR(s["bulk_packing_fraction"], M_PI / 6, 1e-12);
   EXPECT_DOUBLE_EQ(s["coordination"], 6);
   EXPECT_NEAR(s["height_packing_fraction"], M_PI / 6, 1e-12);  // 8 layers on 8 x 8 mm
   EXPECT_DOUBLE_EQ(s["packing_fraction"], 0.535);              // cycles 3 and 4 only
   EXPECT_DOUBLE_EQ(s["wall_force_full_compression"], 35);
+  EXPECT_DOUBLE_EQ(s["wall_force_unloaded"], 1.65);  // the store's wall_force, cycles 3-4
   EXPECT_TRUE(std::isnan(s["lid_height"]));
   // Across the window (cycles 3 to 4): the store's values rise by 0.01 and 10 per cycle,
   // the rotation per cycle and the lattice do not change.
   EXPECT_NEAR(s.drift_of("packing_fraction"), 0.01, 1e-12);
   EXPECT_NEAR(s.drift_of("wall_force_full_compression"), 10, 1e-12);
+  EXPECT_NEAR(s.drift_of("wall_force_unloaded"), -0.1, 1e-12);
   EXPECT_NEAR(s.drift_of("rot_disp"), 0, 1e-12);
   EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
 }

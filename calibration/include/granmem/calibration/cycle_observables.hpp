@@ -87,6 +87,8 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
 //                                container's cross-section (the run's box; NaN without)
 //   packing_fraction             from the lid height (simulations; the store's)
 //   wall_force_full_compression  N (the store's)
+//   wall_force_unloaded          N: the store's wall force at each cycle's end, the wall back
+//                                at its start (the packing's lateral stress once unloaded)
 struct SteadyState {
   std::vector<std::string> names;
   std::vector<double> values;

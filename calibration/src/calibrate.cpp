@@ -1044,13 +1044,17 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
 }  // namespace
 
 CalibrateOptions CalibrateOptions::with_default_design() const {
-  const bool steady = observables == CalibrationObservables::steady_state;
+  struct Design {
+    std::vector<double> mu_s;
+    int replicas;
+  };
+  const Design design = joint() ? Design{{0.05, 0.12, 0.3}, 2}
+                        : observables == CalibrationObservables::steady_state
+                            ? Design{{0.05, 0.1, 0.2, 0.4}, 3}
+                            : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
-  if (o.mu_s.empty()) {
-    o.mu_s = steady ? std::vector<double>{0.05, 0.1, 0.2, 0.4}
-                    : std::vector<double>{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5};
-  }
-  if (o.replicas == 0) o.replicas = steady ? 3 : 2;
+  if (o.mu_s.empty()) o.mu_s = design.mu_s;
+  if (o.replicas == 0) o.replicas = design.replicas;
   return o;
 }
 

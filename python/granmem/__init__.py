@@ -339,8 +339,9 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     ("auto" too where the store has them, else fits it on scans).
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
-    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs), for "displacements"
-    0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5 on 2.
+    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs), for the joint fit 0.05,
+    0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08, 0.12, 0.2, 0.3,
+    0.5 on 2.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``

@@ -78,9 +78,10 @@ struct CalibrateOptions {
   const std::atomic<bool>* stop = nullptr;
 
   bool joint() const { return !mu_r.empty(); }
-  // These options with the twin's design where they leave it: for the steady state 3
-  // packings x mu_s 0.05, 0.1, 0.2, 0.4 (12 runs: the design docs/CALIBRATION.md measures
-  // on pseudo-experiments), for the displacements 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
+  // These options with the twin's design where they leave it, the one docs/CALIBRATION.md
+  // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.1, 0.2, 0.4 (12
+  // runs), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r), for the displacements
+  // 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
   CalibrateOptions with_default_design() const;
   // --window's text: FIRST:LAST, or auto (`option` names it in an error).
   void set_window(const std::string& text, const std::string& option);

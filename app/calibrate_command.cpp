@@ -25,12 +25,12 @@ std::vector<std::string> parse_names(const std::string& text) {
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
     std::string experiment, out, mu_s, window, noise = "auto", wall_distance = "0",
-                                               preparation = "each", summaries = "pooled",
+                                               preparation = "auto", summaries = "pooled",
                                                observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 0, refine = 0;
-    std::string axis_noise = "auto";
+    std::string axis_noise = "auto", placed_jitter = "auto";
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -83,9 +83,18 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "
                   "(as the experiment was prepared); shared: one packing per seed deposited at "
-                  "the twin's --mu-s, its friction switched before the drive")
+                  "the twin's --mu-s, its friction switched before the drive; experiment: "
+                  "every run starts from the experiment's own packing, its first frame's "
+                  "grains moved by --placed-jitter and settled at the run's mu_s; auto: "
+                  "experiment for a steady-state fit of mu_s on a simulation's packing (its "
+                  "first frame exact: cycle 0, every grain), else each")
       ->capture_default_str()
-      ->check(CLI::IsMember({"each", "shared"}));
+      ->check(CLI::IsMember({"each", "shared", "experiment", "auto"}));
+  cmd->add_option("--placed-jitter", args->placed_jitter,
+                  "--deposit experiment: each replica's grains moved from the experiment's by a "
+                  "normal draw of this RMS a coordinate (a length); auto: 1e-4 grain "
+                  "diameters")
+      ->capture_default_str();
   cmd->add_option("--summaries", args->summaries,
                   "pooled: the CDF of the window's pooled displacements (the paper's steady "
                   "state); per-cycle: each cycle's CDF (a transient, e.g. the first cycles after "
@@ -155,7 +164,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.degree = args->degree;
     o.replicas = args->replicas;
     o.refine = args->refine;
-    o.preparation = args->preparation == "shared" ? TwinPreparation::shared : TwinPreparation::each;
+    o.preparation = preparation_named(args->preparation);
+    if (args->placed_jitter != "auto") {
+      o.placed_jitter = parse_si(args->placed_jitter, Dimension::length, "m", "--placed-jitter");
+    }
     o.fit_only = args->fit_only;
     o.parallel = args->threads;
     o.log = [](const std::string& line) { std::cerr << line << "\n"; };

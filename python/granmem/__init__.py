@@ -319,8 +319,8 @@ def _frictions(value):
 def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
-              refine=0, axis_noise="auto", deposit="each", fit_only=False, parallel=0, progress=None,
-              **twin):
+              refine=0, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
+              parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -336,7 +336,12 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     axis (a scan's), added to the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
     ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors
-    ("auto" too where the store has them, else fits it on scans).
+    ("auto" too where the store has them, else fits it on scans). ``deposit``: "each" (every
+    run pours its own packing at its friction), "shared" (one per seed, its friction
+    switched) or "experiment" (every run starts from the experiment's first frame's grains,
+    each replica moved by ``placed_jitter``, a length; "auto": 1e-4 grain diameters) or "auto" (the default:
+    "experiment" for a steady-state fit of mu_s on a simulation's packing, whose first frame
+    holds it exactly, else "each").
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
     "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs), for the joint fit 0.05,
@@ -356,6 +361,6 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                               int(degree), None if replicas is None else int(replicas), int(refine),
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
-                              deposit,
+                              deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
                               bool(fit_only),
                               int(parallel), twin, progress)

@@ -754,8 +754,8 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       const std::string& summaries, const std::string& wall_distance,
                       bool subtract_drift, int degree, const std::optional<int>& replicas,
                       int refine, const std::string& axis_noise, const std::string& deposit,
-                      bool fit_only, int parallel, const py::dict& twin,
-                      const py::object& progress) {
+                      const std::string& placed_jitter, bool fit_only, int parallel,
+                      const py::dict& twin, const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
   o.out = out;
@@ -784,10 +784,10 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   }
   o.refine = refine;
   o.axis_noise = parse_axis_noise(axis_noise, "axis_noise");
-  if (deposit != "each" && deposit != "shared") {
-    throw Error("deposit '" + deposit + "': expected each or shared");
+  o.preparation = preparation_named(deposit, "deposit");
+  if (placed_jitter != "auto") {
+    o.placed_jitter = parse_si(placed_jitter, Dimension::length, "m", "placed_jitter");
   }
-  o.preparation = deposit == "shared" ? TwinPreparation::shared : TwinPreparation::each;
   o.fit_only = fit_only;
   o.parallel = parallel;
   ReportQueue queue;
@@ -919,8 +919,8 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("wall_distance") = "0", py::arg("subtract_drift") = true,
         py::arg("degree") = CalibrateOptions{}.degree, py::arg("replicas") = py::none(),
         py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = "auto",
-        py::arg("deposit") = "each", py::arg("fit_only") = false, py::arg("parallel") = 0,
-        py::arg("twin") = py::dict(), py::arg("progress") = py::none());
+        py::arg("deposit") = "auto", py::arg("placed_jitter") = "auto", py::arg("fit_only") = false,
+        py::arg("parallel") = 0, py::arg("twin") = py::dict(), py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,

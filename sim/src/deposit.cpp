@@ -119,12 +119,18 @@ Grains insert_grains(const DepositOptions& o, const PhysicsOptions& physics) {
 
 Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, DepositSummary* summary,
                    const DepositProgress& progress) {
-  Grains grains = insert_grains(o, physics);
+  return settled_packing(insert_grains(o, physics), o, physics, GrainPlacement::poured, summary,
+                         progress);
+}
+
+Simulation settled_packing(Grains grains, const DepositOptions& o, const PhysicsOptions& physics,
+                           GrainPlacement placement, DepositSummary* summary,
+                           const DepositProgress& progress) {
   Container box;
   box.size = {o.box_side, o.box_side};
 
   Simulation sim(std::move(grains), box, physics);
-  double settling = settle(sim, o, "falling", progress);
+  double settling = placement == GrainPlacement::poured ? settle(sim, o, "falling", progress) : 0.0;
 
   if (o.lid_mass > 0) {
     const double top = packing_height(sim);
@@ -135,6 +141,8 @@ Simulation deposit(const DepositOptions& o, const PhysicsOptions& physics, Depos
     lid.v = 0;
     sim.refresh_forces();
     settling += settle(sim, o, "under the lid", progress);
+  } else if (placement == GrainPlacement::at_rest) {
+    settling += settle(sim, o, "in place", progress);
   }
   sim = in_spatial_order(sim);
   if (summary) {

@@ -162,6 +162,24 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
                        {"--axis-noise", ">= 0"});
 }
 
+// A twin that stops short of the experiment's friction holds the fit at its edge: said, with
+// what to simulate.
+TEST_F(Calibrate, SaysWhenTheFitIsAtTheDesignsEdge) {
+  // A straight trend (--degree 1): its misfit falls all the way to the edge.
+  const RunResult r =
+      granmem_ok(calibrate({"--window", "2:3", "--mu-s", "0.02,0.03,0.05", "--degree", "1",
+                            "--observables", "steady-state", "--fit-only"}));
+  const std::string json = read_text(in_work("cal/summary.json"));
+  if (json_value(json, "mu_s") > 0.05 / 1.01) {
+    EXPECT_NE(r.out.find("the fit is at the twin's highest mu_s, 0.05: the experiment's may lie "
+                         "beyond it; simulate past it (--mu-s with 0.1)"),
+              std::string::npos)
+        << r.out;
+  } else {
+    ADD_FAILURE() << "the true 0.2 fitted inside 0.02-0.05: " << r.out;
+  }
+}
+
 // --noise scans: the locating noise is the scans' own, the RMS of the position standard
 // errors in the store, not fitted. The pseudo-experiment as scans of 0.1 mm voxels (0.15
 // along z) would store it: each centre known to 0.05, 0.05 and 0.075 mm (half a voxel).
@@ -234,6 +252,63 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
   const RunResult from_shared = granmem_ok(shared);
   EXPECT_NE(from_shared.out.find("8 simulations"), std::string::npos) << from_shared.out;
   EXPECT_TRUE(std::filesystem::exists(in_work("shared/packing_seed_4.checkpoint.h5")));
+}
+
+// --deposit experiment: every run starts from the experiment's own packing, its first
+// frame's grains jittered by the run's seed and settled at the run's friction: at the true
+// friction the twin starts where the experiment does, its pour's scatter gone. The default
+// (auto) does so for a simulation's packing, and pours for scans.
+TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
+  const std::vector<std::string> design{"--window",      "2:3",          "--mu-s",    "0.1,0.2,0.4",
+                                        "--observables", "steady-state", "--fit-only"};
+  const RunResult r = granmem_ok(calibrate(design));
+  EXPECT_NE(r.err.find("placed where the experiment's first frame has its 60 grains, moved by "
+                       "0.0005 mm RMS"),
+            std::string::npos)
+      << r.err;
+  const std::string json = read_text(in_work("cal/summary.json"));
+  EXPECT_NE(json.find("\"deposit\": \"experiment\""), std::string::npos) << json;
+  expect_fit_in_its_interval(json);
+  // Before the first cycle, the packing's height: the twin's placed packings at the true
+  // friction against the experiment's, and poured packings against it.
+  const double d = 0.005;
+  auto start_height = [](const std::string& file) {
+    return TrajectoryReader(file).observables().at("lid_height").value.front();
+  };
+  const double experiment = start_height(in_work("exp.h5"));
+  for (const char* seed : {"1", "2"}) {
+    const std::string run = in_work(std::string("cal/runs/mu_s_0.2_seed_") + seed + ".h5");
+    EXPECT_NEAR(start_height(run), experiment, 0.01 * d) << run;
+  }
+  std::vector<std::string> poured = design;
+  poured.insert(poured.end(), {"--deposit", "each"});
+  granmem_ok(calibrate(poured));  // the same folder: poured runs are other runs, not reused
+  double off = 0;
+  for (const char* seed : {"1", "2"}) {
+    const std::string run = in_work(std::string("cal/runs/mu_s_0.2_seed_") + seed + ".h5");
+    off = std::max(off, std::abs(start_height(run) - experiment));
+  }
+  EXPECT_GT(off, 0.05 * d);
+  // Scans' centres carry their errors: the default pours, and placing is said to lean.
+  Trajectories scans = read_trajectories(in_work("exp.h5"));
+  scans.header.has_position_error = true;
+  for (Frame& f : scans.frames)
+    f.position_error = Eigen::RowVector3d(2e-5, 2e-5, 3e-5).replicate(f.position.rows(), 1);
+  write_trajectories(in_work("scans.h5"), scans);
+  std::vector<std::string> from_scans = calibrate(design);
+  from_scans[2] = "scans.h5";
+  EXPECT_NE(granmem_ok(from_scans).err.find("deposited at each friction"), std::string::npos);
+  from_scans.insert(from_scans.end(), {"--deposit", "experiment"});
+  EXPECT_NE(granmem_ok(from_scans).err.find("fit leans to higher friction"), std::string::npos);
+  // The packing before the first cycle is what the twin starts from.
+  Trajectories later = read_trajectories(in_work("exp.h5"));
+  later.frames.erase(later.frames.begin());
+  write_trajectories(in_work("later.h5"), later);
+  std::vector<std::string> from_later = calibrate(design);
+  from_later[2] = "later.h5";
+  EXPECT_NE(granmem_ok(from_later).err.find("deposited at each friction"), std::string::npos);
+  from_later.insert(from_later.end(), {"--deposit", "experiment"});
+  expect_clean_failure(from_later, {"later.h5", "--deposit experiment", "not cycle 0"});
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "granmem/calibration/friction_series.hpp"
+#include "granmem/core/trajectory_store.hpp"
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/run_settings.hpp"
 #include "granmem/sim/simulate_settings.hpp"
@@ -25,8 +27,27 @@ enum class CalibrationObservables { displacements, steady_state };
 
 // How the twin's packings are made: each run deposits its own grains at its friction (as
 // the experiment was prepared), or one packing per seed is deposited once (kept in the
-// output folder) and its friction switched before the drive.
-enum class TwinPreparation { each, shared };
+// output folder) and its friction switched before the drive, or each run starts from the
+// experiment's own packing, its first frame's grains (placed_packing.hpp) jittered by the
+// run's seed and settled at the run's friction. Automatic: the experiment's own packing
+// where its first frame holds it exactly (exact_first_packing()) and the fit is mu_s's on
+// the steady state, where it was measured (docs/CALIBRATION.md); else each its own.
+enum class TwinPreparation { each, shared, experiment, automatic };
+// The jitter of a replica of the experiment's packing (m per coordinate, in grain
+// diameters): what stands for the microstate a frame does not hold (contact forces,
+// velocities), small enough not to move the placed packing (its springs' overlaps under the
+// lid are ~1e-3 d; moved by 1e-2 d, a 2,500-grain packing settled 1 % denser, by 1e-4 d as
+// it was), and the runs' chaos grows it to a replica's scatter within cycles.
+inline constexpr double kPlacedJitterDiameters = 1e-4;
+// The preparation's name in options, the summary and the runs' parameters.
+const char* preparation_name(TwinPreparation preparation);
+// Its name read back (each, shared, experiment, auto); Error naming `option` otherwise.
+TwinPreparation preparation_named(const std::string& name, const std::string& option = "--deposit");
+// Whether a run's first frame holds its packing before the first cycle exactly: a
+// simulation's (orientations, no positions' standard errors) at cycle 0 with every grain.
+// A scan's carries its locating errors, and a packing placed from it settles denser (a
+// 2,500-grain packing placed with 20 um errors, 0.0017 in packing fraction).
+bool exact_first_packing(const TrajectoryReader& run);
 
 struct CalibrateOptions {
   std::filesystem::path experiment;  // the experiment's trajectory store
@@ -61,7 +82,10 @@ struct CalibrateOptions {
   // Packings per friction (seeds seed, seed + 1, ...); 0: the observables' own design (so a
   // caller's 0 is not refused, it is the default).
   int replicas = 0;
-  TwinPreparation preparation = TwinPreparation::each;
+  TwinPreparation preparation = TwinPreparation::automatic;
+  // m: TwinPreparation::experiment: each replica's grains moved from the experiment's by a
+  // normal draw of this RMS per coordinate; NaN: kPlacedJitterDiameters grain diameters.
+  double placed_jitter = std::nan("");
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
   // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
@@ -89,6 +113,10 @@ struct CalibrateOptions {
   // calibrate() also checks them against the experiment before any run.
   void validate() const;
 };
+
+// The preparation `options` ask for, automatic resolved for `experiment`.
+TwinPreparation resolved_preparation(const CalibrateOptions& options,
+                                     const TrajectoryReader& experiment);
 
 struct CalibrateSummary {
   double mu_s = 0;

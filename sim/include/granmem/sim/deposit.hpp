@@ -49,6 +49,19 @@ DepositProgress print_deposit_progress(std::ostream& out);
 Simulation deposit(const DepositOptions& options, const PhysicsOptions& physics,
                    DepositSummary* summary = nullptr, const DepositProgress& progress = {});
 
+// Where settled_packing()'s grains come from: inserted loose above the floor (deposit()),
+// or at rest where a frame has them (placed_packing.hpp), already packed.
+enum class GrainPlacement { poured, at_rest };
+
+// deposit()'s stages from `grains` already in the box: poured grains settled under gravity,
+// then the lid placed on the highest grain and settled again; grains at rest in a packing
+// get the lid at once (settled without it, a packing placed with no contact forces would
+// first spread and sag under its own weight, then be pressed again). The grains are
+// relabelled in spatial order.
+Simulation settled_packing(Grains grains, const DepositOptions& options,
+                           const PhysicsOptions& physics, GrainPlacement placement,
+                           DepositSummary* summary = nullptr, const DepositProgress& progress = {});
+
 // Runs `sim` under the settling drag of `options` until the kinetic energy per grain is
 // below options.settled_energy (deposit()'s stages); returns the simulated time it took.
 // Throws Error if that takes longer than options.max_settling_time.

@@ -1,0 +1,90 @@
+#include "granmem/sim/placed_packing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "granmem/core/error.hpp"
+#include "granmem/core/random.hpp"
+#include "granmem/core/units.hpp"
+
+namespace granmem {
+namespace {
+
+// Each grain's position in `frame`, or in the first later frame that has it (NaN if none).
+Vectors3 positions_filled_forward(const TrajectoryReader& run, std::size_t frame) {
+  Vectors3 x = run.read_frame(frame).position;
+  auto missing = [&] {
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      if (!x.row(i).allFinite()) return true;
+    return false;
+  };
+  for (std::size_t t = frame + 1; t < run.frame_count() && missing(); ++t) {
+    const Vectors3 later = run.read_frame(t).position;
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      if (!x.row(i).allFinite()) x.row(i) = later.row(i);
+  }
+  return x;
+}
+
+// Each grain inside the side walls and above the floor.
+void keep_in_box(Grains& grains, const DepositOptions& deposit) {
+  for (std::size_t i = 0; i < grains.size(); ++i) {
+    Eigen::Vector3d& x = grains.x[i];
+    const double r = grains.radius[i];
+    for (int d = 0; d < 2; ++d)
+      x(d) = std::clamp(x(d), r, deposit.box_side - r);
+    x.z() = std::max(x.z(), r);
+  }
+}
+
+Eigen::Quaterniond orientation_of(const Frame& f, Eigen::Index i) {
+  if (f.orientation.rows() > i && f.orientation.row(i).allFinite()) {
+    const auto q = f.orientation.row(i);
+    return Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized();
+  }
+  if (f.axis.rows() > i && f.axis.row(i).allFinite()) {
+    return Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), f.axis.row(i).transpose());
+  }
+  return Eigen::Quaterniond::Identity();
+}
+
+}  // namespace
+
+Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
+                       const DepositOptions& deposit, const PhysicsOptions& physics) {
+  if (frame >= run.frame_count()) {
+    throw Error(run.file_name() + ": has no frame " + std::to_string(frame) +
+                " to place grains from");
+  }
+  const RunHeader& h = run.header();
+  if (h.length_unit == "voxel") {
+    throw Error(run.file_name() + ": positions in voxels; grains are placed in a length unit " +
+                "(track with --voxel-size)");
+  }
+  const double metres = metres_per(h.length_unit);
+  const Eigen::Vector3d corner = h.box ? h.box->lower : Eigen::Vector3d::Zero();
+  const Frame f = run.read_frame(frame);
+  const Vectors3 x = positions_filled_forward(run, frame);
+  Grains grains;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) {
+    if (!x.row(i).allFinite()) continue;
+    const double located = h.radius[std::size_t(i)] * metres;
+    const double r =
+        deposit.polydispersity == 0 || !std::isfinite(located) ? deposit.radius : located;
+    grains.add(h.id[std::size_t(i)], (x.row(i).transpose() - corner) * metres, r, physics.density);
+    grains.q.back() = orientation_of(f, i);
+  }
+  if (grains.size() == 0) throw Error(run.file_name() + ": no grain located to place");
+  return grains;
+}
+
+Grains jittered(Grains grains, double jitter, std::uint64_t seed, const DepositOptions& deposit) {
+  Random random(seed);
+  for (Eigen::Vector3d& x : grains.x)
+    x += jitter * normal_vector(random);
+  keep_in_box(grains, deposit);
+  return grains;
+}
+
+}  // namespace granmem

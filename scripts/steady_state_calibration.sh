@@ -21,6 +21,8 @@
 # --refine N: the two-stage twin, N packings of new seeds added at the --mu-s x --replicas
 # design's fit (`calibrate --refine`); its fits in DIR/fit_refineN_<pseudo>, DIR/fits_refineN.csv.
 # --only: the observables fitted (default all the pseudo-experiment has).
+# The twin is poured (--deposit each), one shared by all the pseudo-experiments, as these
+# studies were measured; the default since 2026-11-26 places each one's own (its own runs).
 # Writes DIR/fits.csv (one line per pseudo-experiment) and each fit's folder.
 set -euo pipefail
 
@@ -94,7 +96,7 @@ for p in "${names[@]}"; do
   mkdir -p "$fit"
   ln -sfn ../runs "$fit/runs"
   "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "$fit" \
-    --mu-s "$mus" --replicas "$replicas" --refine "$refine" "${only[@]}" \
+    --mu-s "$mus" --replicas "$replicas" --refine "$refine" "${only[@]}" --deposit each \
     --observables steady-state --fit-only --threads 2 2> "$fit.log" | tee "$fit.txt"
   awk -v p="$p" '/"mu_s":/ {gsub(/[,]/, ""); m = $2}
     /"mu_s_ci95":/ {gsub(/[][,]/, " "); lo = $2; hi = $3}

@@ -260,10 +260,10 @@ class Twin {
     count_located_grains();
     observe = observable_options(o_, experiment, deposit_, errors);
     measured = measured_observables(experiment, observe);
+    if (o_.preparation == TwinPreparation::experiment) place_experiments_grains();
     series_ = series_options();
     for (int r = 0; r < o_.replicas; ++r)
       seeds_.push_back(deposit_.seed + std::uint64_t(r));
-    if (o_.preparation == TwinPreparation::experiment) place_experiments_grains();
   }
 
   ScanErrors errors;  // the experiment's own, from its scans
@@ -362,7 +362,7 @@ class Twin {
       say("note: the experiment's first frame does not hold its packing exactly (a scan's "
           "centres carry their locating errors, and grains it missed are taken from later "
           "frames): placed there, the twin's packings settle denser than the experiment's "
-          "was (centres off by 20 um: +0.0017 in packing fraction on 2,500 grains), so the "
+          "was (centres off by 20 um: +0.0016 in packing fraction on 2,500 grains), so the "
           "fit leans to higher friction with too narrow an interval; --deposit each pours "
           "the twin's own");
     }
@@ -438,6 +438,19 @@ class Twin {
     placed_ = grains_of_frame(experiment_, 0, deposit_, physics_);
     placed_jitter_ = std::isfinite(o_.placed_jitter) ? o_.placed_jitter
                                                      : kPlacedJitterDiameters * 2 * deposit_.radius;
+  }
+
+  // The placed packing's grain count and a digest of its grains' positions.
+  std::string placed_identity() const {
+    std::uint64_t digest = 1469598103934665603ull;  // FNV-1a over the positions' bytes
+    for (const Eigen::Vector3d& x : placed_->x) {
+      const auto* bytes = reinterpret_cast<const unsigned char*>(x.data());
+      for (std::size_t b = 0; b < 3 * sizeof(double); ++b)
+        digest = (digest ^ bytes[b]) * 1099511628211ull;
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
+    return std::to_string(placed_->size()) + " grains, positions digest " + hex;
   }
 
   // Shared packings: one per seed (the design's, or `more`), kept in the output folder so
@@ -525,6 +538,10 @@ class Twin {
     for (const auto& [key, value] : settings_)
       series.protocol.parameters["simulate/" + key] = value;
     series.protocol.parameters["calibrate/deposit"] = preparation_name(o_.preparation);
+    if (placed_) {  // runs placed from another experiment's packing are other runs
+      series.protocol.parameters["calibrate/placed_from"] = placed_identity();
+      series.protocol.parameters["calibrate/placed_jitter"] = number_text(placed_jitter_) + " m";
+    }
     series.protocol.validate(deposit_.box_side, physics_.dt);
     return series;
   }
@@ -1177,6 +1194,10 @@ void CalibrateOptions::validate() const {
   }
   if (joint() && mu_r.size() < 3) throw Error("--mu-r: the joint fit needs at least 3 values");
   if (replicas < 1) throw Error("--replicas: at least one packing");
+  // Replicas of a placed packing differ by their jitter alone: none, and they are one run.
+  if (!std::isnan(placed_jitter) && !(placed_jitter > 0 && std::isfinite(placed_jitter))) {
+    throw Error("--placed-jitter: a length > 0 (replicas not moved would all be the same run)");
+  }
   if (degree < 1) throw Error("--degree: at least 1");
   // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
   const std::size_t needed = std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);

@@ -11,20 +11,25 @@
 namespace granmem {
 namespace {
 
-// Each grain's position in `frame`, or in the first later frame that has it (NaN if none).
-Vectors3 positions_filled_forward(const TrajectoryReader& run, std::size_t frame) {
-  Vectors3 x = run.read_frame(frame).position;
+// `frame`, each grain it misses taken (position, orientation, axis) from the first later
+// frame that has it (NaN if none).
+Frame filled_forward(const TrajectoryReader& run, std::size_t frame) {
+  Frame f = run.read_frame(frame);
   auto missing = [&] {
-    for (Eigen::Index i = 0; i < x.rows(); ++i)
-      if (!x.row(i).allFinite()) return true;
+    for (Eigen::Index i = 0; i < f.position.rows(); ++i)
+      if (!f.position.row(i).allFinite()) return true;
     return false;
   };
   for (std::size_t t = frame + 1; t < run.frame_count() && missing(); ++t) {
-    const Vectors3 later = run.read_frame(t).position;
-    for (Eigen::Index i = 0; i < x.rows(); ++i)
-      if (!x.row(i).allFinite()) x.row(i) = later.row(i);
+    const Frame later = run.read_frame(t);
+    for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
+      if (f.position.row(i).allFinite()) continue;
+      f.position.row(i) = later.position.row(i);
+      if (f.orientation.rows() > i) f.orientation.row(i) = later.orientation.row(i);
+      if (f.axis.rows() > i) f.axis.row(i) = later.axis.row(i);
+    }
   }
-  return x;
+  return f;
 }
 
 // Each grain inside the side walls and above the floor.
@@ -64,8 +69,8 @@ Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
   }
   const double metres = metres_per(h.length_unit);
   const Eigen::Vector3d corner = h.box ? h.box->lower : Eigen::Vector3d::Zero();
-  const Frame f = run.read_frame(frame);
-  const Vectors3 x = positions_filled_forward(run, frame);
+  const Frame f = filled_forward(run, frame);
+  const Vectors3& x = f.position;
   Grains grains;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     if (!x.row(i).allFinite()) continue;

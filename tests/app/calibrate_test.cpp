@@ -280,6 +280,13 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
     const std::string run = in_work(std::string("cal/runs/mu_s_0.2_seed_") + seed + ".h5");
     EXPECT_NEAR(start_height(run), experiment, 0.01 * d) << run;
   }
+  // Placed runs are reused only for the same packing placed the same way.
+  std::vector<std::string> again = design;
+  EXPECT_NE(granmem_ok(calibrate(again)).err.find("reusing 6 finished runs"), std::string::npos);
+  again.insert(again.end(), {"--placed-jitter", "1um"});
+  EXPECT_EQ(granmem_ok(calibrate(again)).err.find("reusing"), std::string::npos);
+  again.back() = "0um";
+  expect_clean_failure(calibrate(again), {"--placed-jitter", "> 0"});
   std::vector<std::string> poured = design;
   poured.insert(poured.end(), {"--deposit", "each"});
   granmem_ok(calibrate(poured));  // the same folder: poured runs are other runs, not reused

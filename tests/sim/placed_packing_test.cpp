@@ -53,21 +53,36 @@ double rms_nearest(const Grains& a, const Grains& b) {
 }
 
 TEST_F(PlacedPacking, AFramesGrainsArePlacedWhereItHasThem) {
-  const TrajectoryReader run(path("run.h5"));
+  // The run as a tracked store would hold it: in mm, the container's corner off the origin.
+  Trajectories t = read_trajectories(path("run.h5"));
+  const Eigen::Vector3d corner(1.5, -2.0, 0.25);  // mm
+  t.header.length_unit = "mm";
+  t.header.box = Box{corner, Eigen::Vector3d(30, 30, 60)};
+  for (Frame& f : t.frames)
+    for (Eigen::Index i = 0; i < f.position.rows(); ++i)
+      f.position.row(i) = f.position.row(i) * 1e3 + corner.transpose();
+  write_trajectories(path("mm.h5"), t);
+  const TrajectoryReader run(path("mm.h5"));
   const Grains g = grains_of_frame(run, 0, pour, physics);
   ASSERT_EQ(g.size(), 300u);
   EXPECT_LT(rms_nearest(g, poured), 1e-12);
   for (std::size_t i = 0; i < g.size(); ++i) {
     EXPECT_EQ(g.radius[i], pour.radius);
-    EXPECT_NEAR(std::abs(g.q[i].norm()), 1, 1e-12);
+    for (std::size_t j = 0; j < poured.size(); ++j) {
+      if (poured.id[j] != g.id[i]) continue;
+      EXPECT_NEAR((g.x[i] - poured.x[j]).norm(), 0, 1e-12);
+      EXPECT_NEAR(std::abs(g.q[i].dot(poured.q[j])), 1, 1e-12);  // the same rotation
+    }
   }
   EXPECT_THROW(grains_of_frame(run, 3, pour, physics), Error);
 }
 
 TEST_F(PlacedPacking, AGrainTheFrameMissesIsTakenFromTheNextThatHasIt) {
   Trajectories t = read_trajectories(path("run.h5"));
-  t.frames[0].position.row(7).setConstant(NAN);
-  t.frames[1].position.row(7).setConstant(NAN);
+  for (int k : {0, 1}) {
+    t.frames[std::size_t(k)].position.row(7).setConstant(NAN);
+    t.frames[std::size_t(k)].orientation.row(7).setConstant(NAN);
+  }
   t.frames[0].position.row(9).setConstant(NAN);
   for (Frame& f : t.frames)
     f.position.row(11).setConstant(NAN);  // never seen: left out
@@ -83,6 +98,13 @@ TEST_F(PlacedPacking, AGrainTheFrameMissesIsTakenFromTheNextThatHasIt) {
   const auto id7 = t.header.id[7], id9 = t.header.id[9];
   EXPECT_EQ(placed(id7), t.frames[2].position.row(7).transpose());
   EXPECT_EQ(placed(id9), t.frames[1].position.row(9).transpose());
+  // Its orientation from the same frame as its position.
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    if (g.id[i] != id7) continue;
+    const auto q = t.frames[2].orientation.row(7);
+    EXPECT_NEAR(std::abs(g.q[i].dot(Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized())), 1,
+                1e-12);
+  }
 }
 
 TEST_F(PlacedPacking, EachReplicaIsJitteredByItsRmsAndStaysInTheBox) {

@@ -46,7 +46,7 @@ TwinPreparation preparation_named(const std::string& name, const std::string& op
 // Whether a run's first frame holds its packing before the first cycle exactly: a
 // simulation's (orientations, no positions' standard errors) at cycle 0 with every grain.
 // A scan's carries its locating errors, and a packing placed from it settles denser (a
-// 2,500-grain packing placed with 20 um errors, 0.0017 in packing fraction).
+// 2,500-grain packing placed with 20 um errors, 0.0016 in packing fraction).
 bool exact_first_packing(const TrajectoryReader& run);
 
 struct CalibrateOptions {

@@ -178,4 +178,9 @@ def test_bad_calibrations_are_one_clear_error(tmp_path, experiment):
         granmem.calibrate(experiment, tmp_path / "x", mu_s=[0.1, 0.2], **TWIN)
     with pytest.raises(granmem.Error, match="twin has 3%"):
         granmem.calibrate(experiment, tmp_path / "x", **{**FIT, **TWIN, "amplitude": "3%"})
+    with pytest.raises(granmem.Error, match="deposit 'poured': expected each, shared, experiment or auto"):
+        granmem.calibrate(experiment, tmp_path / "x", deposit="poured", **FIT, **TWIN)
+    with pytest.raises(granmem.Error, match="placed-jitter: a length > 0"):
+        granmem.calibrate(experiment, tmp_path / "x", deposit="experiment", placed_jitter=0,
+                          **FIT, **TWIN)
     assert not (tmp_path / "x").exists()  # refused before any output

@@ -165,9 +165,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.replicas = args->replicas;
     o.refine = args->refine;
     o.preparation = preparation_named(args->preparation);
-    if (args->placed_jitter != "auto") {
-      o.placed_jitter = parse_si(args->placed_jitter, Dimension::length, "m", "--placed-jitter");
-    }
+    o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
     o.fit_only = args->fit_only;
     o.parallel = args->threads;
     o.log = [](const std::string& line) { std::cerr << line << "\n"; };

@@ -1275,6 +1275,11 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   return s;
 }
 
+double parse_placed_jitter(const std::string& text, const std::string& option) {
+  if (trim(text) == "auto") return std::nan("");
+  return parse_si(text, Dimension::length, "m", option);
+}
+
 std::optional<double> parse_axis_noise(const std::string& text, const std::string& option) {
   if (trim(text) == "auto") return std::nullopt;
   const Quantity q = parse_quantity(text, option);

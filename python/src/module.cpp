@@ -785,9 +785,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.refine = refine;
   o.axis_noise = parse_axis_noise(axis_noise, "axis_noise");
   o.preparation = preparation_named(deposit, "deposit");
-  if (placed_jitter != "auto") {
-    o.placed_jitter = parse_si(placed_jitter, Dimension::length, "m", "placed_jitter");
-  }
+  o.placed_jitter = parse_placed_jitter(placed_jitter, "placed_jitter");
   o.fit_only = fit_only;
   o.parallel = parallel;
   ReportQueue queue;

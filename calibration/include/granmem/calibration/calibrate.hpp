@@ -150,6 +150,9 @@ std::vector<double> parse_frictions(const std::string& text, const std::string& 
 // --axis-noise's text: auto (unset: the experiment's own), or an angle in degrees (a bare
 // number or "deg"), returned in radians; an Error naming `option` otherwise.
 std::optional<double> parse_axis_noise(const std::string& text, const std::string& option);
+// --placed-jitter's text: auto (NaN, CalibrateOptions::placed_jitter's default) or a length
+// in m; Error naming `option` otherwise.
+double parse_placed_jitter(const std::string& text, const std::string& option);
 
 // Whether a `simulate` setting may be given to the twin: calibrate sets the runs' output,
 // cycles and mu_s itself, and the twin keeps no checkpoints, tracks or samples.

@@ -4,7 +4,9 @@
 // settling where it was.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "granmem/core/error.hpp"
 #include "granmem/core/trajectory_store.hpp"
@@ -40,16 +42,21 @@ class PlacedPacking : public testing::TempDirTest {
   Grains poured;
 };
 
-// The nearest grain of `b` to each of `a`: the RMS distance, in m.
-double rms_nearest(const Grains& a, const Grains& b) {
-  double sum = 0;
+// The distance from each grain of `a` to the nearest of `b`, in m, sorted.
+std::vector<double> nearest_distances(const Grains& a, const Grains& b) {
+  std::vector<double> distances;
   for (const Eigen::Vector3d& x : a.x) {
     double best = INFINITY;
     for (const Eigen::Vector3d& y : b.x)
-      best = std::min(best, (x - y).squaredNorm());
-    sum += best;
+      best = std::min(best, (x - y).norm());
+    distances.push_back(best);
   }
-  return std::sqrt(sum / double(a.size()));
+  std::sort(distances.begin(), distances.end());
+  return distances;
+}
+
+double quantile(const std::vector<double>& sorted, double q) {
+  return sorted[std::min(sorted.size() - 1, std::size_t(q * double(sorted.size())))];
 }
 
 TEST_F(PlacedPacking, AFramesGrainsArePlacedWhereItHasThem) {
@@ -65,7 +72,7 @@ TEST_F(PlacedPacking, AFramesGrainsArePlacedWhereItHasThem) {
   const TrajectoryReader run(path("mm.h5"));
   const Grains g = grains_of_frame(run, 0, pour, physics);
   ASSERT_EQ(g.size(), 300u);
-  EXPECT_LT(rms_nearest(g, poured), 1e-12);
+  EXPECT_LT(nearest_distances(g, poured).back(), 1e-12);
   for (std::size_t i = 0; i < g.size(); ++i) {
     EXPECT_EQ(g.radius[i], pour.radius);
     for (std::size_t j = 0; j < poured.size(); ++j) {
@@ -133,13 +140,18 @@ TEST_F(PlacedPacking, APackingAtRestPlacedAgainSettlesWhereItWas) {
   // The deposited packing (frame 0) placed with no contact forces and the lid on it at once:
   // the springs of its contacts build again within microns of slip (a contact's load over
   // k_t), so it settles where it was. (Settled first without the lid, as a pour is, it
-  // moved by 0.077 d RMS and its lid came 0.04 d lower.)
+  // moved by 0.077 d RMS and its lid came 0.04 d lower.) A few unloaded grains may still
+  // drop into a gap below them (up to 0.2 d measured), so the bulk is what is asserted.
   const TrajectoryReader run(path("run.h5"));
   DepositSummary after;
   Simulation again = settled_packing(grains_of_frame(run, 0, pour, physics), pour, physics,
                                      GrainPlacement::at_rest, &after);
   const double d = 2 * pour.radius;
-  EXPECT_LT(rms_nearest(again.grains(), poured), 0.01 * d);  // measured 0.003 d
+  const std::vector<double> moved = nearest_distances(again.grains(), poured);
+  // Measured over pour seeds 1-9 and two compilers: median 0.0007-0.0029 d, 90th
+  // percentile 0.0023-0.0108 d.
+  EXPECT_LT(quantile(moved, 0.5), 0.005 * d);
+  EXPECT_LT(quantile(moved, 0.9), 0.02 * d);
   const double lid = run.observables().at("lid_height").value.front();
   EXPECT_NEAR(after.lid_height, lid, 0.01 * d);  // measured 0.0027 d lower
 }

@@ -43,8 +43,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--out,-o", args->out, "output folder")->required();
   CLI::Option* mu_s_option =
       cmd->add_option("--mu-s", args->mu_s,
-                      "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4, "
-                      "the joint fit 0.05,0.12,0.3, displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
+                      "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4 "
+                      "(placed: 0.05,0.08,0.13,0.21,0.35,0.6), the joint fit 0.05,0.12,0.3, "
+                      "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
   cmd->add_option("--window", args->window,
                   "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
                   "experiment's last 10; steady-state: auto, the longest window ending there "
@@ -71,8 +72,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->capture_default_str();
   cmd->add_option("--replicas", args->replicas,
                   "packings per friction (seeds seed, seed+1, ...): their scatter is the "
-                  "realization noise the interval includes; default steady-state 3, the joint "
-                  "fit and displacements 2")
+                  "realization noise the interval includes; default steady-state 3 (placed 2), "
+                  "the joint fit and displacements 2")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "

@@ -129,6 +129,13 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
                                                      : TwinPreparation::each;
 }
 
+CalibrateOptions resolved_options(const CalibrateOptions& given,
+                                  const TrajectoryReader& experiment) {
+  CalibrateOptions options = given;
+  options.preparation = resolved_preparation(given, experiment);
+  return options.with_default_design();
+}
+
 namespace {
 
 // The experiment's friction (mu-s, mu-r) where granmem simulated it (a pseudo-experiment),
@@ -1170,10 +1177,14 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
     std::vector<double> mu_s;
     int replicas;
   };
+  const bool steady = observables == CalibrationObservables::steady_state;
+  // A placed twin's replicas differ by their jitter alone and scatter little, so two per
+  // friction measure it, and the runs spared reach past 0.4.
   const Design design = joint() ? Design{{0.05, 0.12, 0.3}, 2}
-                        : observables == CalibrationObservables::steady_state
-                            ? Design{{0.05, 0.1, 0.2, 0.4}, 3}
-                            : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
+                        : steady && preparation == TwinPreparation::experiment
+                            ? Design{{0.05, 0.08, 0.13, 0.21, 0.35, 0.6}, 2}
+                        : steady ? Design{{0.05, 0.1, 0.2, 0.4}, 3}
+                                 : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
   if (o.mu_s.empty()) o.mu_s = design.mu_s;
   if (o.replicas == 0) o.replicas = design.replicas;
@@ -1243,10 +1254,9 @@ void CalibrateOptions::set_window(const std::string& text, const std::string& op
 }
 
 CalibrateSummary calibrate(const CalibrateOptions& given) {
-  CalibrateOptions options = given.with_default_design();
-  options.validate();
-  const TrajectoryReader experiment(options.experiment);
-  options.preparation = resolved_preparation(options, experiment);
+  given.with_default_design().validate();  // the options checked before the experiment is read
+  const TrajectoryReader experiment(given.experiment);
+  const CalibrateOptions options = resolved_options(given, experiment);
   Twin twin(options, experiment);  // every setting checked before any output
   CalibrateSummary s;
   s.true_mu_s = true_friction(experiment.header(), "mu-s");

@@ -344,7 +344,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     holds it exactly, else "each").
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
-    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs), for the joint fit 0.05,
+    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs; a twin placed from the
+    experiment's packing 0.05, 0.08, 0.13, 0.21, 0.35, 0.6 on 2), for the joint fit 0.05,
     0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08, 0.12, 0.2, 0.3,
     0.5 on 2.
 

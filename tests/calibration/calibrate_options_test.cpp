@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "granmem/calibration/calibrate.hpp"
+#include "granmem/core/trajectory_store.hpp"
+#include "temp_dir.hpp"
 
 namespace granmem {
 namespace {
@@ -16,6 +18,12 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   EXPECT_EQ(s.mu_s, (std::vector<double>{0.05, 0.1, 0.2, 0.4}));
   EXPECT_EQ(s.replicas, 3);  // 12 runs: the grid of the steady-state pseudo-experiments
   EXPECT_NO_THROW(s.validate());
+  CalibrateOptions placed = steady;
+  placed.preparation = TwinPreparation::experiment;
+  const CalibrateOptions p = placed.with_default_design();
+  EXPECT_EQ(p.mu_s, (std::vector<double>{0.05, 0.08, 0.13, 0.21, 0.35, 0.6}));
+  EXPECT_EQ(p.replicas, 2);  // 12 runs reaching past 0.4: placed replicas scatter little
+  EXPECT_NO_THROW(p.validate());
   const CalibrateOptions d = CalibrateOptions{}.with_default_design();
   EXPECT_EQ(d.mu_s, (std::vector<double>{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}));
   EXPECT_EQ(d.replicas, 2);
@@ -29,6 +37,47 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   const CalibrateOptions given = steady.with_default_design();
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 4);
+}
+
+class ResolvedOptions : public testing::TempDirTest {
+ protected:
+  // A two-grain store whose first frame is cycle 0: a simulation's (orientations), or a
+  // scan's (positions' standard errors).
+  std::filesystem::path store(bool scan) {
+    Trajectories t;
+    t.header.id = {1, 2};
+    t.header.radius = {0.0025, 0.0025};
+    t.header.box = Box{Eigen::Vector3d::Zero(), Eigen::Vector3d(0.02, 0.02, 0.04)};
+    t.header.has_orientation = !scan;
+    t.header.has_position_error = scan;
+    Frame f = Frame::unknown(t.header);
+    f.position << 0.005, 0.005, 0.0025, 0.012, 0.005, 0.0025;
+    if (scan) {
+      f.position_error.setConstant(5e-6);
+    } else {
+      f.orientation.setZero();
+      f.orientation.col(0).setOnes();  // the identity
+    }
+    t.frames.push_back(f);
+    const auto p = path(scan ? "scan.h5" : "sim.h5");
+    write_trajectories(p, t);
+    return p;
+  }
+};
+
+TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
+  CalibrateOptions steady;
+  steady.observables = CalibrationObservables::steady_state;
+  const CalibrateOptions placed = resolved_options(steady, TrajectoryReader(store(false)));
+  EXPECT_EQ(placed.preparation, TwinPreparation::experiment);
+  EXPECT_EQ(placed.mu_s.back(), 0.6);
+  EXPECT_EQ(placed.replicas, 2);
+  const CalibrateOptions poured = resolved_options(steady, TrajectoryReader(store(true)));
+  EXPECT_EQ(poured.preparation, TwinPreparation::each);
+  EXPECT_EQ(poured.mu_s.back(), 0.4);
+  EXPECT_EQ(poured.replicas, 3);
+  steady.mu_s = {0.1, 0.2, 0.4};  // a design given is kept, placed or not
+  EXPECT_EQ(resolved_options(steady, TrajectoryReader(store(false))).mu_s, steady.mu_s);
 }
 
 }  // namespace

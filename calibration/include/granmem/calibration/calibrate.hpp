@@ -104,8 +104,9 @@ struct CalibrateOptions {
   bool joint() const { return !mu_r.empty(); }
   // These options with the twin's design where they leave it, the one docs/CALIBRATION.md
   // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.1, 0.2, 0.4 (12
-  // runs), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r), for the displacements
-  // 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
+  // runs), placed (TwinPreparation::experiment, as resolved_preparation() gives it) 2 x
+  // 0.05, 0.08, 0.13, 0.21, 0.35, 0.6 (12 runs reaching past 0.4), for the joint fit 2 x mu_s 0.05,
+  // 0.12, 0.3 (x each mu_r), for the displacements 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
   CalibrateOptions with_default_design() const;
   // --window's text: FIRST:LAST, or auto (`option` names it in an error).
   void set_window(const std::string& text, const std::string& option);
@@ -117,6 +118,10 @@ struct CalibrateOptions {
 // The preparation `options` ask for, automatic resolved for `experiment`.
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
                                      const TrajectoryReader& experiment);
+// The options calibrate() runs: the preparation resolved for `experiment`, then the design
+// where `given` leaves it (with_default_design(): a placed twin's own).
+CalibrateOptions resolved_options(const CalibrateOptions& given,
+                                  const TrajectoryReader& experiment);
 
 struct CalibrateSummary {
   double mu_s = 0;

@@ -26,8 +26,10 @@ export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # Left out: tests of minutes under the sanitizers (whole protocols, read-out sweeps, large
 # renders) and the memory measurements (the sanitizers' shadow memory is in the RSS).
-# Under the sanitizers these take 10 s to 4 min each (~40 min in all); the rest ~4 min and
-# the three other PlacedPacking tests (a 300-grain pour each) ~2.5 min each.
+# Under the sanitizers these take 10 s to 4 min each (~40 min in all). What runs: ~4 min,
+# plus ~2.5 min each for the three other PlacedPacking tests (a 300-grain pour each). The
+# settle left out asserts physics the normal build checks (its bounds measured under clang
+# ASan too, once).
 slow="ReadoutSweep\.|Locate\.|SettledPile\.|HoleAxis\.NoTiltUnderABlurWiderAlongZ"
 slow+="|CyclicSamples\.|Illumination\.|Restart\.(AKept|Resumed|Stopped)"
 slow+="|Render\.(SameSeed|HoleLies)|StackMemoryTest\."

@@ -1254,9 +1254,10 @@ void CalibrateOptions::set_window(const std::string& text, const std::string& op
 }
 
 CalibrateSummary calibrate(const CalibrateOptions& given) {
-  given.with_default_design().validate();  // the options checked before the experiment is read
+  // The design, and so what is valid, depends on the preparation the experiment resolves.
   const TrajectoryReader experiment(given.experiment);
   const CalibrateOptions options = resolved_options(given, experiment);
+  options.validate();
   Twin twin(options, experiment);  // every setting checked before any output
   CalibrateSummary s;
   s.true_mu_s = true_friction(experiment.header(), "mu-s");

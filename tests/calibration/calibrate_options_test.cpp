@@ -76,8 +76,14 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   EXPECT_EQ(poured.preparation, TwinPreparation::each);
   EXPECT_EQ(poured.mu_s.back(), 0.4);
   EXPECT_EQ(poured.replicas, 3);
+  CalibrateOptions each = steady;  // a simulation poured when asked: the grid
+  each.preparation = TwinPreparation::each;
+  EXPECT_EQ(resolved_options(each, TrajectoryReader(store(false))).mu_s.back(), 0.4);
   steady.mu_s = {0.1, 0.2, 0.4};  // a design given is kept, placed or not
-  EXPECT_EQ(resolved_options(steady, TrajectoryReader(store(false))).mu_s, steady.mu_s);
+  steady.replicas = 3;
+  const CalibrateOptions given = resolved_options(steady, TrajectoryReader(store(false)));
+  EXPECT_EQ(given.mu_s, steady.mu_s);
+  EXPECT_EQ(given.replicas, 3);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "granmem/core/error.hpp"
 #include "granmem/core/json_file.hpp"
 #include "granmem/core/option_values.hpp"
+#include "granmem/core/random.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/table.hpp"
 #include "granmem/core/units.hpp"
@@ -449,12 +450,9 @@ class Twin {
 
   // The placed packing's grain count and a digest of its grains' positions.
   std::string placed_identity() const {
-    std::uint64_t digest = 1469598103934665603ull;  // FNV-1a over the positions' bytes
-    for (const Eigen::Vector3d& x : placed_->x) {
-      const auto* bytes = reinterpret_cast<const unsigned char*>(x.data());
-      for (std::size_t b = 0; b < 3 * sizeof(double); ++b)
-        digest = (digest ^ bytes[b]) * 1099511628211ull;
-    }
+    std::uint64_t digest = kFnv1aBasis;
+    for (const Eigen::Vector3d& x : placed_->x)
+      digest = fnv1a(x.data(), sizeof(double) * 3, digest);
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
     return std::to_string(placed_->size()) + " grains, positions digest " + hex;

@@ -8,6 +8,7 @@
 
 #include "granmem/calibration/cycle_observables.hpp"
 #include "granmem/core/error.hpp"
+#include "granmem/core/random.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/core/units.hpp"
@@ -21,12 +22,8 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // A run's bootstrap seed from its store's name, so that its error bars do not depend on
 // where the run stands in the sweep (FNV-1a: the same on every platform).
 std::uint64_t run_seed(std::uint64_t seed, const std::filesystem::path& store) {
-  std::uint64_t h = 14695981039346656037ull;
-  for (unsigned char c : store.filename().string()) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return seed ^ h;
+  const std::string name = store.filename().string();
+  return seed ^ fnv1a(name.data(), name.size());
 }
 
 struct MeanWithError {

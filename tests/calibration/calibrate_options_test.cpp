@@ -68,7 +68,8 @@ class ResolvedOptions : public testing::TempDirTest {
 TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   CalibrateOptions steady;
   steady.observables = CalibrationObservables::steady_state;
-  const CalibrateOptions placed = resolved_options(steady, TrajectoryReader(store(false)));
+  const TrajectoryReader simulation(store(false));
+  const CalibrateOptions placed = resolved_options(steady, simulation);
   EXPECT_EQ(placed.preparation, TwinPreparation::experiment);
   EXPECT_EQ(placed.mu_s.back(), 0.6);
   EXPECT_EQ(placed.replicas, 2);
@@ -78,10 +79,10 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   EXPECT_EQ(poured.replicas, 3);
   CalibrateOptions each = steady;  // a simulation poured when asked: the grid
   each.preparation = TwinPreparation::each;
-  EXPECT_EQ(resolved_options(each, TrajectoryReader(store(false))).mu_s.back(), 0.4);
+  EXPECT_EQ(resolved_options(each, simulation).mu_s.back(), 0.4);
   steady.mu_s = {0.1, 0.2, 0.4};  // a design given is kept, placed or not
   steady.replicas = 3;
-  const CalibrateOptions given = resolved_options(steady, TrajectoryReader(store(false)));
+  const CalibrateOptions given = resolved_options(steady, simulation);
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 3);
 }

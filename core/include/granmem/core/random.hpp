@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <random>
 
@@ -26,6 +27,16 @@ template <class Source>
 Eigen::Vector3d normal_vector(Source& source) {
   const double z = source.normal(), y = source.normal(), x = source.normal();
   return {x, y, z};
+}
+
+// FNV-1a of `size` bytes, continuing from `hash`: a digest (or a seed) that is the same
+// on every platform, unlike std::hash.
+inline constexpr std::uint64_t kFnv1aBasis = 14695981039346656037ull;
+inline std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t hash = kFnv1aBasis) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t b = 0; b < size; ++b)
+    hash = (hash ^ bytes[b]) * 1099511628211ull;
+  return hash;
 }
 
 }  // namespace granmem

@@ -29,7 +29,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                                observables = "displacements", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
-    int threads = 0, degree = 2, replicas = 0, refine = 0;
+    int threads = 0, degree = 2, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto";
   };
   auto args = std::make_shared<Args>();
@@ -44,7 +44,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   CLI::Option* mu_s_option =
       cmd->add_option("--mu-s", args->mu_s,
                       "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4 "
-                      "(placed: 0.05,0.08,0.13,0.21,0.35,0.6), the joint fit 0.05,0.12,0.3, "
+                      "(placed: 0.05,0.13,0.35,0.6, --refine 4), the joint fit 0.05,0.12,0.3, "
                       "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
   cmd->add_option("--window", args->window,
                   "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
@@ -78,8 +78,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
                   "--replicas design, each its own seed, and the fit made again on every run "
-                  "(they measure one packing's scatter where the experiment is)")
-      ->capture_default_str()
+                  "(they measure one packing's scatter where the experiment is); default 0, "
+                  "placed with --mu-s and --replicas left out 4")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "
@@ -164,7 +164,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.subtract_drift = args->subtract_drift;
     o.degree = args->degree;
     o.replicas = args->replicas;
-    o.refine = args->refine;
+    if (args->refine >= 0) o.refine = args->refine;
     o.preparation = preparation_named(args->preparation);
     o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
     o.fit_only = args->fit_only;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The steady-state friction fit measured on pseudo-experiments (docs/CALIBRATION.md, issue
 # 17): pseudo-experiments simulated by granmem at frictions the fit is not told, then
-# `granmem calibrate --observables steady-state` with one twin shared by all of them.
+# `granmem calibrate --observables steady-state`, with one poured twin shared by all of them
+# or (--deposit experiment) each one's own placed twin.
 # Reduced scale at the paper's lid pressure: 1,500 grains of 5 mm, 5 cm box, 436 Pa,
 # A = 1 %, 40 cycles, window 31:40 (the last 10, as the paper).
 #
@@ -9,6 +10,7 @@
 #                                       [--replicas N] [--joint] [--grains N]
 #                                       [--cycles C] [--window F:L] [--pseudo LIST]
 #                                       [--refine N] [--only LIST]
+#                                       [--deposit each|experiment] [--inertial-number I]
 #
 # --grains, --cycles and --window change the protocol (default 1500, 40, 31:40); --pseudo
 # the pseudo-experiments, as "mu_s:seed,mu_s:seed,..." (default 0.15:7,0.25:8,0.35:9,0.1:10).
@@ -21,8 +23,13 @@
 # --refine N: the two-stage twin, N packings of new seeds added at the --mu-s x --replicas
 # design's fit (`calibrate --refine`); its fits in DIR/fit_refineN_<pseudo>, DIR/fits_refineN.csv.
 # --only: the observables fitted (default all the pseudo-experiment has).
-# The twin is poured (--deposit each), one shared by all the pseudo-experiments, as these
-# studies were measured; the default since 2026-11-26 places each one's own (its own runs).
+# --deposit: each (default) pours the twin, one shared by all the pseudo-experiments, as
+# the studies before 2026-11-26 were measured; experiment places each one's own twin from
+# its packing (runs in DIR/runs_<pseudo>, shared by that pseudo-experiment's fits), with
+# calibrate's placed default (staged) unless --mu-s, --replicas or --refine is given (its
+# fits in DIR/fit_placed_default_<pseudo>, DIR/fits_placed_default.csv).
+# --inertial-number: the drive (default 1e-3, as the studies before 2026-11-26; "default"
+# leaves granmem's own).
 # Writes DIR/fits.csv (one line per pseudo-experiment) and each fit's folder.
 set -euo pipefail
 
@@ -31,19 +38,24 @@ out="$root/out/steady_state_calibration"
 granmem="$root/build/app/granmem"
 mus="0.05,0.1,0.2,0.4"
 replicas=3
+design_given=0
+deposit=each
+inertial=1e-3
 joint=0
 grains=1500
 cycles=40
 window=31:40
 pseudos="0.15:7,0.25:8,0.35:9,0.1:10"
-refine=0
+refine=""
 only=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --out) out="$2"; shift ;;
     --granmem) granmem="$2"; shift ;;
-    --mu-s) mus="$2"; shift ;;
-    --replicas) replicas="$2"; shift ;;
+    --mu-s) mus="$2"; design_given=1; shift ;;
+    --replicas) replicas="$2"; design_given=1; shift ;;
+    --deposit) deposit="$2"; shift ;;
+    --inertial-number) inertial="$2"; shift ;;
     --joint) joint=1 ;;
     --grains) grains="$2"; shift ;;
     --cycles) cycles="$2"; shift ;;
@@ -51,11 +63,17 @@ while [[ $# -gt 0 ]]; do
     --pseudo) pseudos="$2"; shift ;;
     --refine) refine="$2"; shift ;;
     --only) only=(--only "$2"); shift ;;
-    -h|--help) sed -n '2,26p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,33p' "$0"; exit 0 ;;
     *) echo "steady_state_calibration.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift
 done
+case "$deposit" in
+  each | experiment) ;;
+  *) echo "steady_state_calibration.sh: --deposit is each or experiment, not $deposit" >&2; exit 2 ;;
+esac
+design=(--mu-s "$mus" --replicas "$replicas")
+[[ $deposit == experiment && $design_given -eq 0 ]] && design=()
 granmem=$(realpath "$granmem")
 [[ -x $granmem ]] || { echo "steady_state_calibration.sh: no granmem at $granmem" >&2; exit 1; }
 mkdir -p "$out/runs"
@@ -67,7 +85,7 @@ grains = "$grains"
 box = "5cm"
 amplitude = "1%"
 cycles = "$cycles"
-inertial-number = "1e-3"   # the drive docs/CALIBRATION.md's studies were measured at
+$([[ $inertial == default ]] || echo "inertial-number = \"$inertial\"   # the drive")
 [calibrate]
 window = "$window"
 EOF
@@ -89,14 +107,19 @@ for p in ${pseudos//,/ }; do echo "pseudo_${p%%:*}_seed_${p##*:} ${p%%:*} ${p##*
   xargs -P 2 -L 1 bash -c 'pseudo "$@"' _
 
 tag=""
-[[ $refine -gt 0 ]] && tag="_refine$refine"
+refine_args=()
+[[ -n $refine ]] && refine_args=(--refine "$refine")
+[[ ${refine:-0} -gt 0 ]] && tag="_refine$refine"
+[[ -z $refine && ${#design[@]} -eq 0 ]] && tag="_placed_default"
 echo "experiment,mu_s_true,mu_s,ci95_low,ci95_high,n_simulations" > "fits$tag.csv.tmp"
 for p in "${names[@]}"; do
   fit="fit${tag}_$p"
-  mkdir -p "$fit"
-  ln -sfn ../runs "$fit/runs"
+  runs=runs
+  [[ $deposit == experiment ]] && runs="runs_$p"
+  mkdir -p "$fit" "$runs"
+  ln -sfn "../$runs" "$fit/runs"
   "$granmem" --config protocol.toml calibrate --experiment "$p.h5" --out "$fit" \
-    --mu-s "$mus" --replicas "$replicas" --refine "$refine" "${only[@]}" --deposit each \
+    "${design[@]}" "${refine_args[@]}" "${only[@]}" --deposit "$deposit" \
     --observables steady-state --fit-only --threads 2 2> "$fit.log" | tee "$fit.txt"
   awk -v p="$p" '/"mu_s":/ {gsub(/[,]/, ""); m = $2}
     /"mu_s_ci95":/ {gsub(/[][,]/, " "); lo = $2; hi = $3}

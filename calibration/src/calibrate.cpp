@@ -359,7 +359,10 @@ class Twin {
          << " cm, A = " << series_.protocol.drive.amplitude * 100 << " cm, cycles 1-"
          << series_.protocol.cycles << " (window " << observe.window.first << ":"
          << observe.window.second << "), mu_s " << mu << ", " << o_.replicas
-         << " packing(s) from seed " << deposit_.seed << ", " << preparation_text();
+         << " packing(s) from seed " << deposit_.seed;
+    if (o_.refined_packings() > 0)
+      line << ", then " << o_.refined_packings() << " more at their fit";
+    line << ", " << preparation_text();
     if (observe.axis_noise > 0) {
       line << "; the twin's hole axes tilted by " << std::setprecision(3)
            << observe.axis_noise * 180 / M_PI << " deg ("
@@ -890,13 +893,14 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";
     twin.say(line);
   } else {
-    line += std::to_string(o.refine) + " packing(s) more at mu_s " + number_text(at.mu_s) +
-            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") + ", seeds " +
-            std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(o.refine - 1));
+    line += std::to_string(o.refined_packings()) + " packing(s) more at mu_s " +
+            number_text(at.mu_s) + (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") +
+            ", seeds " + std::to_string(twin.next_seed(0)) + "-" +
+            std::to_string(twin.next_seed(o.refined_packings() - 1));
     twin.say(line);
     std::vector<std::uint64_t> seeds;
     std::vector<FrictionRunSpec> more;
-    for (int k = 0; k < o.refine; ++k) {
+    for (int k = 0; k < o.refined_packings(); ++k) {
       seeds.push_back(twin.next_seed(k));
       more.push_back({at.mu_s, seeds.back(), at.mu_r});
     }
@@ -948,7 +952,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   std::sort(simulated.begin(), simulated.end());
   simulated.erase(std::unique(simulated.begin(), simulated.end()), simulated.end());
   j["mu_s_simulated"] = simulated;
-  j["refine"] = o.refine;
+  j["refine"] = o.refined_packings();
+  j["refined"] = specs.size() - o.mu_s.size() * std::size_t(o.replicas);  // 0 at the edge
   j["observables"] = written.observables;
   std::ostringstream left_out;
   report_noise_limited(limited, left_out, j);
@@ -1174,16 +1179,20 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
   struct Design {
     std::vector<double> mu_s;
     int replicas;
+    int refine = 0;
   };
   const bool steady = observables == CalibrationObservables::steady_state;
   // A placed twin's replicas differ by their jitter alone and scatter little, so two per
-  // friction measure it, and the runs spared reach past 0.4.
+  // friction measure it; its range reaches past 0.4, and its last four packings go where
+  // the first eight fit.
   const Design design = joint() ? Design{{0.05, 0.12, 0.3}, 2}
                         : steady && preparation == TwinPreparation::experiment
-                            ? Design{{0.05, 0.08, 0.13, 0.21, 0.35, 0.6}, 2}
+                            ? Design{{0.05, 0.13, 0.35, 0.6}, 2, 4}
                         : steady ? Design{{0.05, 0.1, 0.2, 0.4}, 3}
                                  : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
+  // A design given is run as given: refined only where asked.
+  if (!o.refine) o.refine = o.mu_s.empty() && o.replicas == 0 ? design.refine : 0;
   if (o.mu_s.empty()) o.mu_s = design.mu_s;
   if (o.replicas == 0) o.replicas = design.replicas;
   return o;
@@ -1234,8 +1243,8 @@ void CalibrateOptions::validate() const {
         "--window auto: only with --observables steady-state (a steady window is "
         "where its observables stop changing)");
   }
-  if (refine < 0) throw Error("--refine: a number of packings, 0 or more");
-  if (refine > 0 && !steady) {
+  if (refined_packings() < 0) throw Error("--refine: a number of packings, 0 or more");
+  if (refined_packings() > 0 && !steady) {
     throw Error("--refine: only with --observables steady-state (packings added at the fit)");
   }
   if (auto_window && replicas < 2) {
@@ -1272,7 +1281,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   twin.run(specs);
   std::ostringstream report;
   if (options.auto_window) report << twin.choose_window(specs) << "\n";
-  if (options.refine > 0) specs = refined_design(twin, std::move(specs), report);
+  if (options.refined_packings() > 0) specs = refined_design(twin, std::move(specs), report);
   if (options.joint()) {
     fit_joint(twin, specs, s, report);
   } else if (steady) {

@@ -319,7 +319,7 @@ def _frictions(value):
 def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
-              refine=0, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
+              refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
               parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
@@ -332,8 +332,9 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
-    every run. ``axis_noise`` (steady-state, degrees): the experiment's error in each hole
-    axis (a scan's), added to the twin's exact axes before their rotations are measured;
+    every run (``None``: 0, or 4 for a placed twin's own design). ``axis_noise``
+    (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
+    the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
     ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors
     ("auto" too where the store has them, else fits it on scans). ``deposit``: "each" (every
@@ -345,9 +346,9 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
     "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs; a twin placed from the
-    experiment's packing 0.05, 0.08, 0.13, 0.21, 0.35, 0.6 on 2), for the joint fit 0.05,
-    0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08, 0.12, 0.2, 0.3,
-    0.5 on 2.
+    experiment's packing 0.05, 0.13, 0.35, 0.6 on 2, then 4 more at their fit), for the
+    joint fit 0.05, 0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08,
+    0.12, 0.2, 0.3, 0.5 on 2.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``
@@ -359,7 +360,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
                               summaries, _length(wall_distance), bool(subtract_drift),
-                              int(degree), None if replicas is None else int(replicas), int(refine),
+                              int(degree), None if replicas is None else int(replicas),
+                              None if refine is None else int(refine),
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),

@@ -753,9 +753,9 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       const std::optional<std::string>& window, const std::string& noise,
                       const std::string& summaries, const std::string& wall_distance,
                       bool subtract_drift, int degree, const std::optional<int>& replicas,
-                      int refine, const std::string& axis_noise, const std::string& deposit,
-                      const std::string& placed_jitter, bool fit_only, int parallel,
-                      const py::dict& twin, const py::object& progress) {
+                      const std::optional<int>& refine, const std::string& axis_noise,
+                      const std::string& deposit, const std::string& placed_jitter, bool fit_only,
+                      int parallel, const py::dict& twin, const py::object& progress) {
   CalibrateOptions o;
   o.experiment = experiment;
   o.out = out;
@@ -782,7 +782,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
     if (*replicas < 1) throw Error("replicas: at least one packing");
     o.replicas = *replicas;
   }
-  o.refine = refine;
+  o.refine = refine;  // none: the design's own
   o.axis_noise = parse_axis_noise(axis_noise, "axis_noise");
   o.preparation = preparation_named(deposit, "deposit");
   o.placed_jitter = parse_placed_jitter(placed_jitter, "placed_jitter");
@@ -916,9 +916,9 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("window") = py::none(), py::arg("noise") = "auto", py::arg("summaries") = "pooled",
         py::arg("wall_distance") = "0", py::arg("subtract_drift") = true,
         py::arg("degree") = CalibrateOptions{}.degree, py::arg("replicas") = py::none(),
-        py::arg("refine") = CalibrateOptions{}.refine, py::arg("axis_noise") = "auto",
-        py::arg("deposit") = "auto", py::arg("placed_jitter") = "auto", py::arg("fit_only") = false,
-        py::arg("parallel") = 0, py::arg("twin") = py::dict(), py::arg("progress") = py::none());
+        py::arg("refine") = py::none(), py::arg("axis_noise") = "auto", py::arg("deposit") = "auto",
+        py::arg("placed_jitter") = "auto", py::arg("fit_only") = false, py::arg("parallel") = 0,
+        py::arg("twin") = py::dict(), py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,

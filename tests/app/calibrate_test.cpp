@@ -287,6 +287,25 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   EXPECT_EQ(granmem_ok(calibrate(again)).err.find("reusing"), std::string::npos);
   again.back() = "0um";
   expect_clean_failure(calibrate(again), {"--placed-jitter", "> 0"});
+  // The design left out: a placed twin's own, 2 packings x 0.05, 0.13, 0.35, 0.6, then 4
+  // packings of new seeds where those 8 fit (unless at the range's edge).
+  std::vector<std::string> staged{"calibrate", "--experiment",  "exp.h5",       "--out",
+                                  "staged",    "--observables", "steady-state", "--window",
+                                  "2:3",       "--fit-only"};
+  staged.insert(staged.end(), kTwin.begin(), kTwin.end());
+  const RunResult own = granmem_ok(staged);
+  EXPECT_NE(own.err.find("mu_s 0.05,0.13,0.35,0.6, 2 packing(s) from seed 1, then 4 more"),
+            std::string::npos)
+      << own.err;
+  EXPECT_NE(own.out.find("the design's fit: mu_s = "), std::string::npos) << own.out;
+  EXPECT_NE(own.out.find(", 8 runs; "), std::string::npos) << own.out;
+  // Either way the design is placed and its count said (a 60-grain twin fits well inside).
+  const bool refined = own.out.find("4 packing(s) more at mu_s ") != std::string::npos;
+  EXPECT_TRUE(refined || own.out.find("not refined") != std::string::npos) << own.out;
+  if (refined) EXPECT_NE(own.out.find(", seeds 3-6"), std::string::npos) << own.out;
+  const std::string staged_json = read_text(in_work("staged/summary.json"));
+  EXPECT_EQ(json_value(staged_json, "n_simulations"), refined ? 12 : 8) << own.out;
+  EXPECT_EQ(json_value(staged_json, "refined"), refined ? 4 : 0) << staged_json;
   std::vector<std::string> poured = design;
   poured.insert(poured.end(), {"--deposit", "each"});
   granmem_ok(calibrate(poured));  // the same folder: poured runs are other runs, not reused

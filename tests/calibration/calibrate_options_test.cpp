@@ -17,13 +17,19 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   const CalibrateOptions s = steady.with_default_design();
   EXPECT_EQ(s.mu_s, (std::vector<double>{0.05, 0.1, 0.2, 0.4}));
   EXPECT_EQ(s.replicas, 3);  // 12 runs: the grid of the steady-state pseudo-experiments
+  EXPECT_EQ(s.refine, 0);
   EXPECT_NO_THROW(s.validate());
   CalibrateOptions placed = steady;
   placed.preparation = TwinPreparation::experiment;
   const CalibrateOptions p = placed.with_default_design();
-  EXPECT_EQ(p.mu_s, (std::vector<double>{0.05, 0.08, 0.13, 0.21, 0.35, 0.6}));
-  EXPECT_EQ(p.replicas, 2);  // 12 runs reaching past 0.4: placed replicas scatter little
+  EXPECT_EQ(p.mu_s, (std::vector<double>{0.05, 0.13, 0.35, 0.6}));
+  EXPECT_EQ(p.replicas, 2);  // placed replicas scatter little
+  EXPECT_EQ(p.refine, 4);    // 12 runs: 8 reaching past 0.4, 4 where those fit
   EXPECT_NO_THROW(p.validate());
+  CalibrateOptions unrefined = placed;  // the design, without its second stage
+  unrefined.refine = 0;
+  EXPECT_EQ(unrefined.with_default_design().refine, 0);
+  EXPECT_EQ(unrefined.with_default_design().mu_s.size(), 4u);
   const CalibrateOptions d = CalibrateOptions{}.with_default_design();
   EXPECT_EQ(d.mu_s, (std::vector<double>{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}));
   EXPECT_EQ(d.replicas, 2);
@@ -37,6 +43,10 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   const CalibrateOptions given = steady.with_default_design();
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 4);
+  placed.mu_s = steady.mu_s;  // a placed design given is run as given: refined if asked
+  EXPECT_EQ(placed.with_default_design().refine, 0);
+  placed.refine = 2;
+  EXPECT_EQ(placed.with_default_design().refine, 2);
 }
 
 class ResolvedOptions : public testing::TempDirTest {
@@ -73,10 +83,12 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   EXPECT_EQ(placed.preparation, TwinPreparation::experiment);
   EXPECT_EQ(placed.mu_s.back(), 0.6);
   EXPECT_EQ(placed.replicas, 2);
+  EXPECT_EQ(placed.refine, 4);
   const CalibrateOptions poured = resolved_options(steady, TrajectoryReader(store(true)));
   EXPECT_EQ(poured.preparation, TwinPreparation::each);
   EXPECT_EQ(poured.mu_s.back(), 0.4);
   EXPECT_EQ(poured.replicas, 3);
+  EXPECT_EQ(poured.refine, 0);
   CalibrateOptions each = steady;  // a simulation poured when asked: the grid
   each.preparation = TwinPreparation::each;
   EXPECT_EQ(resolved_options(each, simulation).mu_s.back(), 0.4);
@@ -85,6 +97,7 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   const CalibrateOptions given = resolved_options(steady, simulation);
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 3);
+  EXPECT_EQ(given.refine, 0);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -34,6 +35,11 @@ struct Synthetic {
     const double shared = normal(random);
     return {0.001 * shared, -0.2 * shared + 0.1 * normal(random), 0.0004 * normal(random)};
   }
+  // A truth drawn uniformly in ln mu_s between range[0] and range[1].
+  double log_uniform(const std::array<double, 2>& range) {
+    const double u = std::uniform_real_distribution<>()(random);
+    return std::exp(std::log(range[0]) + std::log(range[1] / range[0]) * u);
+  }
 };
 
 TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
@@ -50,9 +56,7 @@ TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
       for (double mu : frictions)
         runs.push_back({mu, seed, s.values(mu, packing)});
     }
-    const double truth =
-        std::exp(std::log(0.07) +
-                 (std::log(0.4) - std::log(0.07)) * std::uniform_real_distribution<>()(s.random));
+    const double truth = s.log_uniform({0.07, 0.4});
     const std::vector<double> experiment = s.values(truth, s.packing());
     const ObservableFit fit = fit_friction_to_observables(experiment, runs);
     const ObservableFit plain = fit_friction_to_observables(experiment, runs, without_cv);
@@ -72,45 +76,80 @@ TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
   EXPECT_LT(width, 1.0);  // informative: the interval spans well under a factor e
 }
 
+// A design's 95 % intervals over many truths: how often they hold it, how wide they are.
+struct DesignTally {
+  int held = 0, trials = 0;
+  double ln_width = 0;
+  void add(const ObservableFit& fit, double truth) {
+    ++trials;
+    held += fit.mu_s_ci95[0] <= truth && truth <= fit.mu_s_ci95[1];
+    ln_width += std::log(fit.mu_s_ci95[1] / fit.mu_s_ci95[0]);
+  }
+  double coverage() const { return double(held) / trials; }
+  double mean_ln_width() const { return ln_width / trials; }
+};
+
+// Two designs of one cost on the same synthetic twins: `packings` x `first`, then `added`
+// new packings at that fit where it is inside their range (calibrate --refine), against
+// `packings` x `fixed`; 150 truths log-uniform in `truths`.
+struct TwoDesigns {
+  std::vector<double> first;
+  int added;
+  std::vector<double> fixed;
+  int packings;
+  std::array<double, 2> truths;
+};
+std::array<DesignTally, 2> staged_against_fixed(Synthetic& s, const TwoDesigns& d) {
+  std::array<DesignTally, 2> tally;
+  for (int trial = 0; trial < 150; ++trial) {
+    std::vector<ObservableRun> staged, fixed;
+    for (std::uint64_t seed = 1; seed <= std::uint64_t(d.packings); ++seed) {
+      const std::vector<double> packing = s.packing();
+      for (double mu : d.first)
+        staged.push_back({mu, seed, s.values(mu, packing)});
+      const std::vector<double> other = s.packing();
+      for (double mu : d.fixed)
+        fixed.push_back({mu, seed + 10, s.values(mu, other)});
+    }
+    const double truth = s.log_uniform(d.truths);
+    const std::vector<double> experiment = s.values(truth, s.packing());
+    const double at = fit_friction_to_observables(experiment, staged).mu_s;
+    if (at > d.first.front() && at < d.first.back()) {
+      for (int k = 1; k <= d.added; ++k)
+        staged.push_back({at, std::uint64_t(d.packings + k), s.values(at, s.packing())});
+    }
+    tally[0].add(fit_friction_to_observables(experiment, staged), truth);
+    tally[1].add(fit_friction_to_observables(experiment, fixed), truth);
+  }
+  std::printf("staged: coverage %.3f, mean ln width %.3f; fixed: coverage %.3f, %.3f\n",
+              tally[0].coverage(), tally[0].mean_ln_width(), tally[1].coverage(),
+              tally[1].mean_ln_width());
+  return tally;
+}
+
 // calibrate --refine's design on the same synthetic twins: 3 packings x 3 frictions, then
 // 3 new packings at that fit, fitted again on all 12, against the 3 x 4 grid of the same
 // cost. The refined interval holds the truth at its rate too, and is narrower on average
 // (the new packings measure one packing's scatter where the experiment is).
 TEST(ObservableFit, ARefinedDesignHoldsTheTruthAtItsRate) {
   Synthetic s{std::mt19937_64(17)};
-  int held = 0, held_grid = 0;
-  double width = 0, width_grid = 0;
-  const int trials = 150;
-  for (int trial = 0; trial < trials; ++trial) {
-    std::vector<ObservableRun> design, grid;
-    for (std::uint64_t seed : {1, 2, 3}) {
-      const std::vector<double> packing = s.packing();
-      for (double mu : {0.05, 0.14, 0.4})
-        design.push_back({mu, seed, s.values(mu, packing)});
-      const std::vector<double> other = s.packing();
-      for (double mu : {0.05, 0.1, 0.2, 0.4})
-        grid.push_back({mu, seed + 10, s.values(mu, other)});
-    }
-    const double truth =
-        std::exp(std::log(0.07) +
-                 (std::log(0.35) - std::log(0.07)) * std::uniform_real_distribution<>()(s.random));
-    const std::vector<double> experiment = s.values(truth, s.packing());
-    const double at = fit_friction_to_observables(experiment, design).mu_s;
-    if (at > 0.05 && at < 0.4) {
-      for (std::uint64_t seed : {4, 5, 6})
-        design.push_back({at, seed, s.values(at, s.packing())});
-    }
-    const ObservableFit refined = fit_friction_to_observables(experiment, design);
-    const ObservableFit fixed = fit_friction_to_observables(experiment, grid);
-    held += refined.mu_s_ci95[0] <= truth && truth <= refined.mu_s_ci95[1];
-    held_grid += fixed.mu_s_ci95[0] <= truth && truth <= fixed.mu_s_ci95[1];
-    width += std::log(refined.mu_s_ci95[1] / refined.mu_s_ci95[0]) / trials;
-    width_grid += std::log(fixed.mu_s_ci95[1] / fixed.mu_s_ci95[0]) / trials;
-  }
-  std::printf("refined: coverage %.3f, mean ln width %.3f; grid: coverage %.3f, %.3f\n",
-              double(held) / trials, width, double(held_grid) / trials, width_grid);
-  EXPECT_GE(double(held) / trials, 0.88) << held << " of " << trials;
-  EXPECT_LT(width, width_grid);
+  const auto [refined, grid] =
+      staged_against_fixed(s, {{0.05, 0.14, 0.4}, 3, {0.05, 0.1, 0.2, 0.4}, 3, {0.07, 0.35}});
+  EXPECT_GE(refined.coverage(), 0.88) << refined.held << " of " << refined.trials;
+  EXPECT_LT(refined.mean_ln_width(), grid.mean_ln_width());
+}
+
+// A placed twin's two designs of 12 runs, truths to 0.5: the wide one, 2 packings x six
+// frictions 0.05-0.6, and its default, 2 packings x 0.05, 0.13, 0.35, 0.6 and then 4 new
+// packings at that fit. Both hold the truth at their rate; the staged interval is the
+// narrower (a third of its runs sit where the truth is).
+TEST(ObservableFit, APlacedTwinsStagedDesignIsNarrowerThanItsWideOne) {
+  Synthetic s{std::mt19937_64(29)};
+  const auto [staged, wide] = staged_against_fixed(
+      s, {{0.05, 0.13, 0.35, 0.6}, 4, {0.05, 0.08, 0.13, 0.21, 0.35, 0.6}, 2, {0.07, 0.5}});
+  EXPECT_GE(staged.coverage(), 0.88) << staged.held << " of " << staged.trials;
+  EXPECT_GE(wide.coverage(), 0.88) << wide.held << " of " << wide.trials;
+  EXPECT_LT(staged.mean_ln_width(), wide.mean_ln_width());
 }
 
 // The structure informs more at high friction: a packing fraction whose slope in ln mu_s

@@ -90,7 +90,9 @@ struct CalibrateOptions {
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
   // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
   // packing's scatter where the experiment is, as realizations independent of the design's.
-  int refine = 0;
+  // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
+  std::optional<int> refine;
+  int refined_packings() const { return refine.value_or(0); }
   int parallel = 0;  // runs at once, one thread each; 0: all cores
   // Lines saying what the calibration does (the twin, reused runs and packings), the
   // deposition's progress, and each run's progress.
@@ -105,8 +107,9 @@ struct CalibrateOptions {
   // These options with the twin's design where they leave it, the one docs/CALIBRATION.md
   // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.1, 0.2, 0.4 (12
   // runs), placed (TwinPreparation::experiment, as resolved_preparation() gives it) 2 x
-  // 0.05, 0.08, 0.13, 0.21, 0.35, 0.6 (12 runs reaching past 0.4), for the joint fit 2 x mu_s 0.05,
-  // 0.12, 0.3 (x each mu_r), for the displacements 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
+  // 0.05, 0.13, 0.35, 0.6 and 4 packings more at that fit (refine, 12 runs reaching past
+  // 0.4), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r), for the displacements
+  // 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
   CalibrateOptions with_default_design() const;
   // --window's text: FIRST:LAST, or auto (`option` names it in an error).
   void set_window(const std::string& text, const std::string& option);

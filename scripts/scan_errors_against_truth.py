@@ -1,6 +1,7 @@
 """Tracked scans against the DEM run they were rendered from (a pseudo-experiment): each
 scan's position error, the error of each end-of-cycle displacement, how much the errors of
-consecutive scans share, and what locate's stored standard errors predict.
+consecutive scans share, what locate's stored standard errors predict, and the part of the
+errors touching neighbours do not share (what calibrate reads from the contacts' spread).
 Usage: scripts/scan_errors_against_truth.py TRACKS.h5 DEM.h5   (PYTHONPATH=build/python)"""
 import sys
 import numpy as np
@@ -20,7 +21,7 @@ def errors(s):  # each tracked grain's position less its DEM grain's, common off
     e = frame(trk, s) - frame(dem, s)[idx]
     m = ok & np.all(np.isfinite(e), 1)
     return e - np.median(e[m], 0), m
-pos, disp, pred, corr = [], [], [], []
+pos, disp, pred, corr, apart, along, cos_z = [], [], [], [], [], [], []
 sigma = lambda s: trk["position_error"][steps.index(s)] / vox
 for a, b in zip(steps[:-1], steps[1:]):
     ea, ma = errors(a)
@@ -32,6 +33,15 @@ for a, b in zip(steps[:-1], steps[1:]):
 for s in steps:
     e, m = errors(s)
     pos.append(e[m] / vox)
+    # touching neighbours (DEM centres within 1.0 d): their errors' difference / sqrt 2
+    x = frame(dem, s)[idx]
+    pairs = cKDTree(x[m]).query_pairs(d, output_type="ndarray")
+    diff = (e[m][pairs[:, 1]] - e[m][pairs[:, 0]]) / np.sqrt(2)
+    u = x[m][pairs[:, 1]] - x[m][pairs[:, 0]]
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    apart.append(diff / vox)
+    along.append(np.sum(diff * u, 1))
+    cos_z.append(np.abs(u[:, 2]))
 rms = lambda x: np.sqrt(np.mean(np.vstack(x) ** 2, 0))
 print(f"{sys.argv[1]}: {ok.sum()} grains matched, scans {steps[0]}-{steps[-1]}; voxels, x y z")
 print("position error RMS              ", rms(pos).round(4))
@@ -39,3 +49,10 @@ print("its standard error RMS          ", rms([sigma(s)[ok] for s in steps]).rou
 print("displacement error RMS          ", rms(disp).round(4))
 print("predicted, sqrt(s_a^2 + s_b^2)  ", rms(pred).round(4))
 print("consecutive scans' errors, corr.", np.mean(corr, 0).round(3))
+print("touching neighbours' difference / sqrt 2, RMS", rms(apart).round(4),
+      "=", (rms(apart) * vox * 1e6).round(2), "um")
+# along the contact: variance = across^2 (1 - u_z^2) + along_z^2 u_z^2, least squares
+a, uz = np.concatenate(along), np.concatenate(cos_z)
+split = np.linalg.lstsq(np.c_[1 - uz**2, uz**2], a**2, rcond=None)[0]
+print("the same along the contact, across and along z, um", (np.sqrt(split) * 1e6).round(2),
+      "; a contact's mean error", round(np.mean(a) * np.sqrt(2) * 1e6, 2), "um")

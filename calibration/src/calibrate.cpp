@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "granmem/calibration/comparison.hpp"
+#include "granmem/calibration/contact_locating_error.hpp"
 #include "granmem/calibration/cycle_observables.hpp"
 #include "granmem/calibration/figures.hpp"
 #include "granmem/calibration/friction_fit.hpp"
@@ -851,6 +852,39 @@ void report_noise_limited(const std::vector<NoiseLimited>& limited, std::ostream
   j["left_out_for_scan_noise"] = names;
 }
 
+// The scans' locating error read from their contacts against the twin's run nearest the
+// fit (contact_locating_error.hpp): what locate's standard errors miss, said beside them,
+// for scans of grains known to be alike (a simulated experiment's positions are exact).
+void report_contact_error(const Twin& twin, const std::vector<FrictionRunSpec>& specs, double mu_s,
+                          std::ostream& report, JsonObject& j) {
+  const KnownGrains known = twin.known_grains();
+  if (!twin.experiment().header().voxel_size || !known.radius || specs.empty()) return;
+  const auto nearest = std::min_element(specs.begin(), specs.end(), [&](auto& a, auto& b) {
+    return std::abs(std::log(a.mu_s / mu_s)) < std::abs(std::log(b.mu_s / mu_s));
+  });
+  const ContactLocatingError e = locating_error_from_contacts(
+      twin.experiment(), TrajectoryReader(twin.path(*nearest)), 2 * *known.radius);
+  if (!std::isfinite(e.across)) return;
+  const double um = 1e6, stored = metres_per_length(twin.experiment()) * um;
+  report << std::setprecision(2) << "  the scans' centres err by " << e.across * um
+         << " um across the slices and " << e.along_z * um
+         << " um along z, from the spread of their contacts against the twin's (" << e.pairs
+         << " distances; a contact reads " << std::abs(e.offset) * um << " um "
+         << (e.offset < 0 ? "short" : "long") << " on average)";
+  if (twin.errors.position.allFinite()) {
+    report << "; locate's standard errors say "
+           << twin.errors.position.head<2>().norm() / std::sqrt(2.0) * stored << " and "
+           << twin.errors.position.z() * stored << " um";
+  }
+  report << "\n";
+  JsonObject c;
+  c["across_um"] = e.across * um;
+  c["along_z_um"] = e.along_z * um;
+  c["contact_offset_um"] = e.offset * um;
+  c["distances"] = e.pairs;
+  j["locating_error_from_contacts"] = c;
+}
+
 // Strictly inside the range of `simulated`.
 bool interior(double mu, const std::vector<double>& simulated) {
   const auto [lo, hi] = std::minmax_element(simulated.begin(), simulated.end());
@@ -957,6 +991,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["observables"] = written.observables;
   std::ostringstream left_out;
   report_noise_limited(limited, left_out, j);
+  report_contact_error(twin, specs, fit.mu_s, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -1021,6 +1056,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   j["observables"] = fit.names;
   std::ostringstream left_out;
   report_noise_limited(limited, left_out, j);
+  report_contact_error(twin, specs, fit.mu_s, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]

@@ -17,15 +17,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Metres per unit of the run's positions; Error for voxels without a voxel size, whose
-// lengths are not comparable with anything (slices are often coarser than pixels).
-double metres_per_length(const TrajectoryReader& run) {
-  const RunHeader& h = run.header();
-  if (is_physical_length_unit(h.length_unit)) return metres_per(h.length_unit);
-  throw Error(run.file_name() + ": positions are in " + h.length_unit +
-              " without a physical length; import or track it with --voxel-size");
-}
-
 double diameter_for(const TrajectoryReader& run, const ObservableOptions& options) {
   return options.diameter > 0 ? options.diameter : median_diameter(run);
 }
@@ -335,6 +326,13 @@ SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& ob
                          const StructureOptions& structure, const KnownGrains& known) {
   return window_means(observable_series(run, observed, structure, known, observed.window),
                       observed.window);
+}
+
+double metres_per_length(const TrajectoryReader& run) {
+  const RunHeader& h = run.header();
+  if (is_physical_length_unit(h.length_unit)) return metres_per(h.length_unit);
+  throw Error(run.file_name() + ": positions are in " + h.length_unit +
+              " without a physical length; import or track it with --voxel-size");
 }
 
 }  // namespace granmem

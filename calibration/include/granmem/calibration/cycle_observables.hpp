@@ -146,4 +146,8 @@ std::string steady_state_label(const std::string& name);
 // Twice the median finite grain radius of the run, m (Error if it has none).
 double median_diameter(const TrajectoryReader& run);
 
+// Metres per unit of the run's positions; Error for voxels without a voxel size, whose
+// lengths are not comparable with anything (slices are often coarser than pixels).
+double metres_per_length(const TrajectoryReader& run);
+
 }  // namespace granmem

@@ -1,0 +1,179 @@
+#include "granmem/calibration/contact_locating_error.hpp"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/point_index.hpp"
+
+namespace granmem {
+namespace {
+
+// The distances of neighbouring centres near contact, as gaps in diameters (r / d - 1),
+// each with its direction's |u_z|.
+struct NeighbourGaps {
+  std::vector<double> gap, cos_z;
+};
+
+void add_neighbour_gaps(const Vectors3& position, double diameter, double reach,
+                        NeighbourGaps& out) {
+  Vectors3 finite(position.rows(), 3);
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < position.rows(); ++i)
+    if (position.row(i).allFinite()) finite.row(n++) = position.row(i);
+  finite.conservativeResize(n, 3);
+  const PointIndex index(finite);
+  PointIndex::Hits hits;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const Eigen::Vector3d x = finite.row(i).transpose();
+    index.within(x, (1 + reach) * diameter, hits);
+    for (const auto& [j, squared] : hits) {
+      if (Eigen::Index(j) <= i) continue;
+      const double r = std::sqrt(squared);
+      out.gap.push_back(r / diameter - 1);
+      out.cos_z.push_back(std::abs(finite(j, 2) - x.z()) / r);
+    }
+  }
+}
+
+// The scanned gaps counted by |u_z| and gap; the reference's gaps finely, over a range
+// wide enough for the error to carry them into the scanned range.
+struct BinnedGaps {
+  std::vector<double> edges;                           // of the scanned range's bins
+  std::vector<std::vector<double>> counts;             // [direction][bin]
+  std::vector<double> mean_cos2;                       // of each direction's scanned pairs
+  std::vector<double> reference_gap, reference_count;  // fine bins' centres, counts
+  std::size_t pairs = 0;
+};
+
+BinnedGaps binned_gaps(const NeighbourGaps& scanned, const NeighbourGaps& reference,
+                       const ContactErrorOptions& o) {
+  BinnedGaps b;
+  const int bins = int(std::lround((o.below + o.above) / o.bin));
+  for (int j = 0; j <= bins; ++j)
+    b.edges.push_back(-o.below + j * o.bin);
+  b.counts.assign(o.directions, std::vector<double>(bins, 0));
+  std::vector<double> cos2(o.directions, 0), in_direction(o.directions, 0);
+  for (std::size_t p = 0; p < scanned.gap.size(); ++p) {
+    const int j = int(std::floor((scanned.gap[p] + o.below) / o.bin));
+    if (j < 0 || j >= bins) continue;
+    const int k = std::min(o.directions - 1, int(scanned.cos_z[p] * o.directions));
+    b.counts[k][j] += 1;
+    cos2[k] += scanned.cos_z[p] * scanned.cos_z[p];
+    in_direction[k] += 1;
+    ++b.pairs;
+  }
+  for (int k = 0; k < o.directions; ++k)
+    b.mean_cos2.push_back(in_direction[k] > 0 ? cos2[k] / in_direction[k] : 0);
+  const double fine = o.bin / 5, low = -2 * o.below, high = o.above + o.below;
+  const int fine_bins = int(std::lround((high - low) / fine));
+  std::vector<double> count(fine_bins, 0);
+  for (double g : reference.gap) {
+    const int m = int(std::floor((g - low) / fine));
+    if (m >= 0 && m < fine_bins) count[m] += 1;
+  }
+  for (int m = 0; m < fine_bins; ++m) {
+    if (count[m] == 0) continue;
+    b.reference_gap.push_back(low + (m + 0.5) * fine);
+    b.reference_count.push_back(count[m]);
+  }
+  return b;
+}
+
+// Minus the log likelihood of the scanned gaps: in each direction's bins, the reference's
+// gaps moved by the offset and spread by the two centres' errors along the direction,
+// conditioned on the scanned range. Parameters: offset, ln across, ln along_z (diameters).
+struct ContactSpreadLikelihood {
+  const BinnedGaps& b;
+  template <typename T>
+  bool operator()(const T* p, T* cost) const {
+    using std::erf, std::exp, std::log, std::sqrt;
+    const T across2 = exp(T(2) * p[1]), along2 = exp(T(2) * p[2]);
+    cost[0] = T(0);
+    for (std::size_t k = 0; k < b.counts.size(); ++k) {
+      const double c2 = b.mean_cos2[k];
+      const T inv = T(1) / sqrt(T(4) * (across2 * (1 - c2) + along2 * c2));  // 1/(s sqrt 2)
+      std::vector<T> prob(b.counts[k].size(), T(0));
+      for (std::size_t m = 0; m < b.reference_gap.size(); ++m) {
+        const T centre = b.reference_gap[m] + p[0];
+        T below = erf((b.edges[0] - centre) * inv);
+        for (std::size_t j = 0; j < prob.size(); ++j) {
+          const T above = erf((b.edges[j + 1] - centre) * inv);
+          prob[j] += b.reference_count[m] * (above - below);
+          below = above;
+        }
+      }
+      T total = T(0);
+      for (const T& q : prob)
+        total += q;
+      for (std::size_t j = 0; j < prob.size(); ++j)
+        if (b.counts[k][j] > 0) cost[0] -= b.counts[k][j] * log(prob[j] / total + 1e-300);
+    }
+    return true;
+  }
+};
+
+// The fit of the scanned gaps against the reference's.
+ContactLocatingError fitted_contact_error(const NeighbourGaps& scan, const NeighbourGaps& ref,
+                                          double diameter, const ContactErrorOptions& options) {
+  ContactLocatingError e;
+  const BinnedGaps binned = binned_gaps(scan, ref, options);
+  e.pairs = binned.pairs;
+  if (binned.pairs < 100 || binned.reference_gap.empty()) return e;
+  // Started narrow and wide (a start far narrower than the spread sees no gradient where
+  // the distances lie), the likelier kept.
+  ceres::GradientProblem problem(new ceres::AutoDiffFirstOrderFunction<ContactSpreadLikelihood, 3>(
+      new ContactSpreadLikelihood{binned}));
+  ceres::GradientProblemSolver::Options solver;
+  solver.logging_type = ceres::SILENT;
+  double p[3] = {0, 0, 0}, best = INFINITY;
+  for (double start : {1e-3, 5e-3}) {
+    double q[3] = {0, std::log(start), std::log(start)};
+    ceres::GradientProblemSolver::Summary summary;
+    ceres::Solve(solver, problem, q, &summary);
+    if (summary.final_cost < best) {
+      best = summary.final_cost;
+      std::copy(q, q + 3, p);
+    }
+  }
+  if (!std::isfinite(best)) return e;
+  e.offset = p[0] * diameter;
+  e.across = std::exp(p[1]) * diameter;
+  e.along_z = std::exp(p[2]) * diameter;
+  return e;
+}
+
+// Every frame's neighbour gaps, the positions in m.
+NeighbourGaps gaps_of_every_frame(const TrajectoryReader& run, double diameter, double reach) {
+  const double metres = metres_per_length(run);
+  NeighbourGaps gaps;
+  for (std::size_t t = 0; t < run.frame_count(); ++t)
+    add_neighbour_gaps(run.read_frame(t).position * metres, diameter, reach, gaps);
+  return gaps;
+}
+
+}  // namespace
+
+ContactLocatingError locating_error_from_contacts(const Vectors3& scanned,
+                                                  const Vectors3& reference, double diameter,
+                                                  const ContactErrorOptions& options) {
+  const double reach = options.above + options.below;
+  NeighbourGaps scan, ref;
+  add_neighbour_gaps(scanned, diameter, reach, scan);
+  add_neighbour_gaps(reference, diameter, reach, ref);
+  return fitted_contact_error(scan, ref, diameter, options);
+}
+
+ContactLocatingError locating_error_from_contacts(const TrajectoryReader& scans,
+                                                  const TrajectoryReader& reference,
+                                                  double diameter,
+                                                  const ContactErrorOptions& options) {
+  const double reach = options.above + options.below;
+  return fitted_contact_error(gaps_of_every_frame(scans, diameter, reach),
+                              gaps_of_every_frame(reference, diameter, reach), diameter, options);
+}
+
+}  // namespace granmem

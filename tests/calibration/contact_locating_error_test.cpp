@@ -1,0 +1,100 @@
+// A scan's locating error read from its contacts: a packing under the paper's lid pressure,
+// its centres moved by known normal errors (coarser along z, as a laser sheet's slices
+// are), measured against another packing poured under the same load.
+#include "granmem/calibration/contact_locating_error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "granmem/core/random.hpp"
+#include "granmem/sim/deposit.hpp"
+
+namespace granmem {
+namespace {
+
+constexpr double kDiameter = 0.005;
+
+// 400 grains poured into a 3 cm box under 436 Pa; the centres, m.
+Vectors3 poured(std::uint64_t seed) {
+  DepositOptions pour;
+  pour.grains = 400;
+  pour.box_side = 0.03;
+  pour.lid_mass = 436 * 0.03 * 0.03 / 9.81;
+  pour.seed = seed;
+  const Simulation sim = deposit(pour, PhysicsOptions{});
+  const Grains& g = sim.grains();
+  Vectors3 x(Eigen::Index(g.size()), 3);
+  for (std::size_t i = 0; i < g.size(); ++i)
+    x.row(Eigen::Index(i)) = g.x[i].transpose();
+  return x;
+}
+
+// `copies` scans of one packing, each centre moved by its own normal error, one after
+// another along x far enough apart that no two copies touch.
+Vectors3 scanned(const Vectors3& exact, double across, double along_z, int copies,
+                 std::uint64_t seed) {
+  Random random(seed);
+  Vectors3 scans(exact.rows() * copies, 3);
+  for (int c = 0; c < copies; ++c) {
+    for (Eigen::Index i = 0; i < exact.rows(); ++i) {
+      const Eigen::Vector3d e = normal_vector(random);
+      scans.row(c * exact.rows() + i) =
+          exact.row(i) +
+          Eigen::RowVector3d(across * e.x() + c * 0.1, across * e.y(), along_z * e.z());
+    }
+  }
+  return scans;
+}
+
+class ContactLocatingErrorTest : public testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    packing_ = new Vectors3(poured(3));
+    reference_ = new Vectors3(poured(4));
+  }
+  static void TearDownTestSuite() {
+    delete packing_;
+    delete reference_;
+  }
+  static Vectors3* packing_;
+  static Vectors3* reference_;
+};
+Vectors3* ContactLocatingErrorTest::packing_ = nullptr;
+Vectors3* ContactLocatingErrorTest::reference_ = nullptr;
+
+TEST_F(ContactLocatingErrorTest, ReadsAScansErrorsAcrossTheSlicesAndAlongZApart) {
+  // 10 um across, 20 um along z: a 12-pixel render's actual errors are 8 and 16 um.
+  for (std::uint64_t seed : {11, 12}) {
+    const ContactLocatingError e = locating_error_from_contacts(
+        scanned(*packing_, 10e-6, 20e-6, 4, seed), *reference_, kDiameter);
+    EXPECT_GT(e.pairs, 3000u);
+    EXPECT_NEAR(e.across, 10e-6, 1.5e-6) << "seed " << seed;
+    EXPECT_NEAR(e.along_z, 20e-6, 2.5e-6) << "seed " << seed;
+    EXPECT_NEAR(e.offset, 0, 2e-6) << "seed " << seed;
+  }
+  // Three times coarser, as a harsh render's; isotropic.
+  const ContactLocatingError coarse =
+      locating_error_from_contacts(scanned(*packing_, 30e-6, 30e-6, 4, 13), *reference_, kDiameter);
+  EXPECT_NEAR(coarse.across, 30e-6, 4e-6);
+  EXPECT_NEAR(coarse.along_z, 30e-6, 4e-6);
+}
+
+TEST_F(ContactLocatingErrorTest, AnExactPackingReadsLessThanItsOverlaps) {
+  // Another pour's exact centres: what is left is the two packings' overlaps differing
+  // (~1e-3 d under the lid), not an error.
+  const ContactLocatingError e = locating_error_from_contacts(*packing_, *reference_, kDiameter);
+  EXPECT_LT(e.across, 2.5e-6);
+  EXPECT_LT(e.along_z, 2.5e-6);
+}
+
+TEST_F(ContactLocatingErrorTest, TooFewContactsReadNothing) {
+  const ContactLocatingError e =
+      locating_error_from_contacts(packing_->topRows(20), *reference_, kDiameter);
+  EXPECT_LT(e.pairs, 100u);
+  EXPECT_TRUE(std::isnan(e.across));
+  EXPECT_TRUE(std::isnan(e.along_z));
+}
+
+}  // namespace
+}  // namespace granmem

@@ -55,4 +55,13 @@ void PointIndex::nearest(const Eigen::Vector3d& q, std::size_t k, Hits& out) con
     out.emplace_back(index[i], d2[i]);
 }
 
+Vectors3 finite_rows(const Vectors3& points) {
+  Vectors3 finite(points.rows(), 3);
+  Eigen::Index n = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+    if (points.row(i).allFinite()) finite.row(n++) = points.row(i);
+  finite.conservativeResize(n, 3);
+  return finite;
+}
+
 }  // namespace granmem

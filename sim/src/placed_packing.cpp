@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/point_index.hpp"
 #include "granmem/core/random.hpp"
 #include "granmem/core/units.hpp"
 
@@ -12,18 +14,28 @@ namespace granmem {
 namespace {
 
 // `frame`, each grain it misses taken (position, orientation, axis) from the first later
-// frame that has it (NaN if none).
-Frame filled_forward(const TrajectoryReader& run, std::size_t frame) {
+// frame that has it (NaN if none), unless a grain already placed lies within `radius` of
+// it there: then it is that grain, whose track the linker broke across the scans between
+// (two grains' centres are a diameter apart), and placing it again would put two grains
+// in one place.
+Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double radius) {
   Frame f = run.read_frame(frame);
   auto missing = [&] {
     for (Eigen::Index i = 0; i < f.position.rows(); ++i)
       if (!f.position.row(i).allFinite()) return true;
     return false;
   };
+  std::vector<bool> taken(std::size_t(f.position.rows()), false);
   for (std::size_t t = frame + 1; t < run.frame_count() && missing(); ++t) {
     const Frame later = run.read_frame(t);
+    const PointIndex placed(finite_rows(f.position));
+    PointIndex::Hits near;
     for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
-      if (f.position.row(i).allFinite()) continue;
+      if (f.position.row(i).allFinite() || taken[std::size_t(i)]) continue;
+      if (!later.position.row(i).allFinite()) continue;
+      taken[std::size_t(i)] = true;  // its first later frame decides
+      placed.within(later.position.row(i).transpose(), radius, near);
+      if (!near.empty()) continue;
       f.position.row(i) = later.position.row(i);
       if (f.orientation.rows() > i) f.orientation.row(i) = later.orientation.row(i);
       if (f.axis.rows() > i) f.axis.row(i) = later.axis.row(i);
@@ -69,7 +81,7 @@ Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
   }
   const double metres = metres_per(h.length_unit);
   const Eigen::Vector3d corner = h.box ? h.box->lower : Eigen::Vector3d::Zero();
-  const Frame f = filled_forward(run, frame);
+  const Frame f = filled_forward(run, frame, deposit.radius / metres);
   const Vectors3& x = f.position;
   Grains grains;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {

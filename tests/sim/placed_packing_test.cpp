@@ -1,7 +1,7 @@
 // A packing placed where a frame has its grains (the twin started from an experiment's own
 // packing): the frame read back in metres, the grains a frame misses taken from a later
-// one, each replica's jitter, and a packing at rest placed again with no contact history
-// settling where it was.
+// one (once: not a track the linker broke), each replica's jitter, and a packing at rest placed
+// again with no contact history settling where it was.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -111,6 +111,28 @@ TEST_F(PlacedPacking, AGrainTheFrameMissesIsTakenFromTheNextThatHasIt) {
     const auto q = t.frames[2].orientation.row(7);
     EXPECT_NEAR(std::abs(g.q[i].dot(Eigen::Quaterniond(q(0), q(1), q(2), q(3)).normalized())), 1,
                 1e-12);
+  }
+}
+
+TEST_F(PlacedPacking, ATrackTheLinkerBrokeIsNotPlacedTwice) {
+  // Grain 5's track ends at frame 0 and grain 11's starts at frame 1 where grain 5 has moved
+  // by a twentieth of a diameter: the same grain, as a linker that lost it between scans
+  // leaves it. Placed once, where frame 0 has it.
+  Trajectories t = read_trajectories(path("run.h5"));
+  t.frames[0].position.row(11).setConstant(NAN);
+  for (std::size_t k : {1, 2}) {
+    t.frames[k].position.row(11) =
+        t.frames[k].position.row(5) + Eigen::RowVector3d(0.1 * pour.radius, 0, 0);
+    t.frames[k].position.row(5).setConstant(NAN);
+  }
+  write_trajectories(path("broken.h5"), t);
+  const Grains g = grains_of_frame(TrajectoryReader(path("broken.h5")), 0, pour, physics);
+  ASSERT_EQ(g.size(), 299u);
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    EXPECT_NE(g.id[i], t.header.id[11]);
+    if (g.id[i] == t.header.id[5]) {
+      EXPECT_EQ(g.x[i], t.frames[0].position.row(5).transpose());
+    }
   }
 }
 

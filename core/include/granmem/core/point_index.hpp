@@ -36,4 +36,8 @@ class PointIndex {
   std::unique_ptr<Tree> tree_;
 };
 
+// The rows of `points` whose coordinates are all finite, in order (a scan's grains that
+// were located).
+Vectors3 finite_rows(const Vectors3& points);
+
 }  // namespace granmem

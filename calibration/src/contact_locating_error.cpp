@@ -20,11 +20,8 @@ struct NeighbourGaps {
 
 void add_neighbour_gaps(const Vectors3& position, double diameter, double reach,
                         NeighbourGaps& out) {
-  Vectors3 finite(position.rows(), 3);
-  Eigen::Index n = 0;
-  for (Eigen::Index i = 0; i < position.rows(); ++i)
-    if (position.row(i).allFinite()) finite.row(n++) = position.row(i);
-  finite.conservativeResize(n, 3);
+  const Vectors3 finite = finite_rows(position);
+  const Eigen::Index n = finite.rows();
   const PointIndex index(finite);
   PointIndex::Hits hits;
   for (Eigen::Index i = 0; i < n; ++i) {

@@ -116,13 +116,13 @@ TEST_F(PlacedPacking, AGrainTheFrameMissesIsTakenFromTheNextThatHasIt) {
 
 TEST_F(PlacedPacking, ATrackTheLinkerBrokeIsNotPlacedTwice) {
   // Grain 5's track ends at frame 0 and grain 11's starts at frame 1 where grain 5 has moved
-  // by a twentieth of a diameter: the same grain, as a linker that lost it between scans
-  // leaves it. Placed once, where frame 0 has it.
+  // by 0.7 d: the same grain, as a linker that lost it between scans far apart leaves it.
+  // Placed once, where frame 0 has it.
   Trajectories t = read_trajectories(path("run.h5"));
   t.frames[0].position.row(11).setConstant(NAN);
   for (std::size_t k : {1, 2}) {
     t.frames[k].position.row(11) =
-        t.frames[k].position.row(5) + Eigen::RowVector3d(0.1 * pour.radius, 0, 0);
+        t.frames[k].position.row(5) + Eigen::RowVector3d(1.4 * pour.radius, 0, 0);
     t.frames[k].position.row(5).setConstant(NAN);
   }
   write_trajectories(path("broken.h5"), t);

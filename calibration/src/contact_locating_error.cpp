@@ -46,16 +46,23 @@ struct BinnedGaps {
   std::size_t pairs = 0;
 };
 
+// The gaps fitted, in diameters: [-below, above] in `bins` bins.
+struct GapRange {
+  double below, above;
+  int bins, directions;
+  double bin() const { return (below + above) / bins; }
+};
+
 BinnedGaps binned_gaps(const NeighbourGaps& scanned, const NeighbourGaps& reference,
-                       const ContactErrorOptions& o) {
+                       const GapRange& o) {
   BinnedGaps b;
-  const int bins = int(std::lround((o.below + o.above) / o.bin));
+  const int bins = o.bins;
   for (int j = 0; j <= bins; ++j)
-    b.edges.push_back(-o.below + j * o.bin);
+    b.edges.push_back(-o.below + j * o.bin());
   b.counts.assign(o.directions, std::vector<double>(bins, 0));
   std::vector<double> cos2(o.directions, 0), in_direction(o.directions, 0);
   for (std::size_t p = 0; p < scanned.gap.size(); ++p) {
-    const int j = int(std::floor((scanned.gap[p] + o.below) / o.bin));
+    const int j = int(std::floor((scanned.gap[p] + o.below) / o.bin()));
     if (j < 0 || j >= bins) continue;
     const int k = std::min(o.directions - 1, int(scanned.cos_z[p] * o.directions));
     b.counts[k][j] += 1;
@@ -65,7 +72,7 @@ BinnedGaps binned_gaps(const NeighbourGaps& scanned, const NeighbourGaps& refere
   }
   for (int k = 0; k < o.directions; ++k)
     b.mean_cos2.push_back(in_direction[k] > 0 ? cos2[k] / in_direction[k] : 0);
-  const double fine = o.bin / 5, low = -2 * o.below, high = o.above + o.below;
+  const double fine = o.bin() / 5, low = -2 * o.below, high = o.above + o.below;
   const int fine_bins = int(std::lround((high - low) / fine));
   std::vector<double> count(fine_bins, 0);
   for (double g : reference.gap) {
@@ -113,11 +120,11 @@ struct ContactSpreadLikelihood {
   }
 };
 
-// The fit of the scanned gaps against the reference's.
+// The fit of the scanned gaps in `range` against the reference's.
 ContactLocatingError fitted_contact_error(const NeighbourGaps& scan, const NeighbourGaps& ref,
-                                          double diameter, const ContactErrorOptions& options) {
+                                          double diameter, const GapRange& range) {
   ContactLocatingError e;
-  const BinnedGaps binned = binned_gaps(scan, ref, options);
+  const BinnedGaps binned = binned_gaps(scan, ref, range);
   e.pairs = binned.pairs;
   if (binned.pairs < 100 || binned.reference_gap.empty()) return e;
   // Started narrow and wide (a start far narrower than the spread sees no gradient where
@@ -127,8 +134,9 @@ ContactLocatingError fitted_contact_error(const NeighbourGaps& scan, const Neigh
   ceres::GradientProblemSolver::Options solver;
   solver.logging_type = ceres::SILENT;
   double p[3] = {0, 0, 0}, best = INFINITY;
-  for (double start : {1e-3, 5e-3}) {
-    double q[3] = {0, std::log(start), std::log(start)};
+  for (double start : {0.1, 0.3}) {
+    const double spread = start * range.below;
+    double q[3] = {0, std::log(spread), std::log(spread)};
     ceres::GradientProblemSolver::Summary summary;
     ceres::Solve(solver, problem, q, &summary);
     if (summary.final_cost < best) {
@@ -136,11 +144,29 @@ ContactLocatingError fitted_contact_error(const NeighbourGaps& scan, const Neigh
       std::copy(q, q + 3, p);
     }
   }
-  if (!std::isfinite(best)) return e;
+  // A spread the range cannot hold is not read from it.
+  const double widest = range.below / 2;
+  if (!std::isfinite(best) || std::exp(std::max(p[1], p[2])) > widest) return e;
   e.offset = p[0] * diameter;
   e.across = std::exp(p[1]) * diameter;
   e.along_z = std::exp(p[2]) * diameter;
   return e;
+}
+
+// A first fit over a range wide enough for a coarse scan's errors (a quarter of a
+// diameter below contact) finds the spread; the second fits the range it needs, six and
+// three times a contact's spread below and above, at least the options' range, in finer
+// bins.
+constexpr GapRange kScout{0.25, 0.05, 60, 5};
+
+ContactLocatingError contact_error(const NeighbourGaps& scan, const NeighbourGaps& ref,
+                                   double diameter, const ContactErrorOptions& o) {
+  const ContactLocatingError scout = fitted_contact_error(scan, ref, diameter, kScout);
+  if (!std::isfinite(scout.across)) return scout;
+  const double spread = std::sqrt(2.0) * std::max(scout.across, scout.along_z) / diameter;
+  const GapRange range{std::clamp(6 * spread, o.below, kScout.below),
+                       std::clamp(3 * spread, o.above, kScout.above), o.bins, o.directions};
+  return fitted_contact_error(scan, ref, diameter, range);
 }
 
 // Every frame's neighbour gaps, the positions in m.
@@ -157,20 +183,20 @@ NeighbourGaps gaps_of_every_frame(const TrajectoryReader& run, double diameter, 
 ContactLocatingError locating_error_from_contacts(const Vectors3& scanned,
                                                   const Vectors3& reference, double diameter,
                                                   const ContactErrorOptions& options) {
-  const double reach = options.above + options.below;
+  const double reach = kScout.below + kScout.above;
   NeighbourGaps scan, ref;
   add_neighbour_gaps(scanned, diameter, reach, scan);
   add_neighbour_gaps(reference, diameter, reach, ref);
-  return fitted_contact_error(scan, ref, diameter, options);
+  return contact_error(scan, ref, diameter, options);
 }
 
 ContactLocatingError locating_error_from_contacts(const TrajectoryReader& scans,
                                                   const TrajectoryReader& reference,
                                                   double diameter,
                                                   const ContactErrorOptions& options) {
-  const double reach = options.above + options.below;
-  return fitted_contact_error(gaps_of_every_frame(scans, diameter, reach),
-                              gaps_of_every_frame(reference, diameter, reach), diameter, options);
+  const double reach = kScout.below + kScout.above;
+  return contact_error(gaps_of_every_frame(scans, diameter, reach),
+                       gaps_of_every_frame(reference, diameter, reach), diameter, options);
 }
 
 }  // namespace granmem

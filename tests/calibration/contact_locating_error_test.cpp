@@ -73,11 +73,17 @@ TEST_F(ContactLocatingErrorTest, ReadsAScansErrorsAcrossTheSlicesAndAlongZApart)
     EXPECT_NEAR(e.along_z, 20e-6, 2.5e-6) << "seed " << seed;
     EXPECT_NEAR(e.offset, 0, 2e-6) << "seed " << seed;
   }
-  // Three times coarser, as a harsh render's; isotropic.
+  // Three times coarser; isotropic.
   const ContactLocatingError coarse =
       locating_error_from_contacts(scanned(*packing_, 30e-6, 30e-6, 4, 13), *reference_, kDiameter);
   EXPECT_NEAR(coarse.across, 30e-6, 4e-6);
   EXPECT_NEAR(coarse.along_z, 30e-6, 4e-6);
+  // A 9-pixel render's with three times the noise: 130 and 190 um (0.026 and 0.038 d), past
+  // the narrowest range's reach; the range is found from the data.
+  const ContactLocatingError harsh = locating_error_from_contacts(
+      scanned(*packing_, 130e-6, 190e-6, 4, 14), *reference_, kDiameter);
+  EXPECT_NEAR(harsh.across, 130e-6, 15e-6);
+  EXPECT_NEAR(harsh.along_z, 190e-6, 25e-6);
 }
 
 TEST_F(ContactLocatingErrorTest, AnExactPackingReadsLessThanItsOverlaps) {

@@ -20,15 +20,17 @@ namespace granmem {
 // The scan's distances near contact are fitted as a simulated packing's under the same
 // load (`reference`, whose distances are exact) convolved with a normal error of variance
 // 2 (across^2 (1 - u_z^2) + along_z^2 u_z^2) along a contact of direction u, plus a mean
-// `offset`: a maximum likelihood over the distances within [1 - below, 1 + above] d,
-// binned by |u_z|, each bin's distances conditioned on lying in the range (grains the
-// scan missed change how many there are, not their spread). Errors that touching
-// neighbours share cancel in a distance, as they do in the structure: `across` and
-// `along_z` are one centre's independent part.
+// `offset`: a maximum likelihood over the distances near contact, binned by |u_z|, each
+// bin's distances conditioned on lying in the range fitted (grains the scan missed change
+// how many there are, not their spread). The range is found from the data: a first fit
+// over 0.75-1.05 d, then six and three times a contact's spread below and above. Errors
+// that touching neighbours share cancel in a distance, as they do in the structure:
+// `across` and `along_z` are one centre's independent part, of the errors' normal core: a
+// grain located beyond the range (a coarse scan's stray) does not count in it.
 struct ContactErrorOptions {
-  double below = 0.03;  // of a diameter
-  double above = 0.01;  // of a diameter
-  double bin = 5e-4;    // the distances' bins, of a diameter
+  double below = 0.03;  // the range fitted at least from (1 - below) d
+  double above = 0.01;  // to (1 + above) d
+  int bins = 80;        // of the distances in the range
   int directions = 5;   // bins of |u_z|, each an equal solid angle
 };
 
@@ -42,7 +44,7 @@ struct ContactLocatingError {
 
 // `scanned` and `reference` in one length unit, `diameter` the grains' (alike) in it;
 // positions that are not finite are left out. NaN results with fewer than 100 scanned
-// distances in the range.
+// distances in the range, or one centre's error over half the range below contact.
 ContactLocatingError locating_error_from_contacts(const Vectors3& scanned,
                                                   const Vectors3& reference, double diameter,
                                                   const ContactErrorOptions& options = {});

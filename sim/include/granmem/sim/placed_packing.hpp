@@ -21,8 +21,9 @@ namespace granmem {
 // frame that has it (tracked ids), and left out if none has, or if a grain already placed
 // lies within 0.75 d of it there (a track the linker broke between scans: that grain).
 // Radii: the deposit's radius when it has no polydispersity (a scan's located radii carry
-// its blur's bias), else the run's radius where known. Orientations: the run's where it has them, else turned so that
-// the body's z axis (the cavity) is the frame's axis, else the identity.
+// its blur's bias), else the run's radius where known. Orientations: the run's where it has
+// them, else turned so that the body's z axis (the cavity) is the frame's axis, else the
+// identity.
 // Throws Error if the run has no such frame, or its lengths are in voxels.
 Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
                        const DepositOptions& deposit, const PhysicsOptions& physics);

@@ -10,18 +10,20 @@
 #   scripts/tracked_twin_study.sh PSEUDO.h5 PROTOCOL.toml FIRST:LAST OUT [GRANMEM]
 #
 # PROTOCOL.toml: the pseudo-experiment's [simulate] and the window as [calibrate] window;
-# FIRST:LAST the window. Writes OUT/tracks.h5, OUT/placed.txt, OUT/poured.txt and the fits'
-# folders; a second call reuses what the first finished.
+# FIRST:LAST the window. Grains of 5 mm in a 5 x 5 cm box (the scans' container, 15 cm
+# tall to hold the packing). Writes OUT/tracks.h5, OUT/placed.txt, OUT/poured.txt and the
+# fits' folders; a second call reuses what the first finished (granmem writes each file
+# whole or not at all).
 set -euo pipefail
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 4 ] || { sed -n 2,15p "$0"; exit 2; }
+[ $# -ge 4 ] || { sed -n 2,16p "$0"; exit 2; }
 pseudo=$(realpath "$1") protocol=$(realpath "$2") window=$3 out=$4
 granmem=$(realpath "${5:-$root/build/app/granmem}")
 first=${window%:*} last=${window#*:}
 mkdir -p "$out/det" && cd "$out"
 
-frames="0 $(seq $((first - 1)) "$last")"
+frames=$( { echo 0; seq $((first > 1 ? first - 1 : 1)) "$last"; } | sort -nu)
 for f in $frames; do
   [ -f "scan$f.tif" ] || "$granmem" render "$pseudo" --frame "$f" --seed $((f + 5)) \
     --out "scan$f.tif" > /dev/null

@@ -854,11 +854,14 @@ void report_noise_limited(const std::vector<NoiseLimited>& limited, std::ostream
 
 // The scans' locating error read from their contacts against the twin's run nearest the
 // fit (contact_locating_error.hpp): what locate's standard errors miss, said beside them,
-// for scans of grains known to be alike (a simulated experiment's positions are exact).
+// for scans of grains known to be alike (a simulated experiment's positions are exact),
+// against a poured twin (one placed from the scans starts from their errors).
 void report_contact_error(const Twin& twin, const std::vector<FrictionRunSpec>& specs, double mu_s,
                           std::ostream& report, JsonObject& j) {
   const KnownGrains known = twin.known_grains();
-  if (!twin.experiment().header().voxel_size || !known.radius || specs.empty()) return;
+  if (!twin.experiment().header().voxel_size || !known.radius || specs.empty() ||
+      twin.options().preparation == TwinPreparation::experiment)
+    return;
   const auto nearest = std::min_element(specs.begin(), specs.end(), [&](auto& a, auto& b) {
     return std::abs(std::log(a.mu_s / mu_s)) < std::abs(std::log(b.mu_s / mu_s));
   });
@@ -866,7 +869,7 @@ void report_contact_error(const Twin& twin, const std::vector<FrictionRunSpec>& 
       twin.experiment(), TrajectoryReader(twin.path(*nearest)), 2 * *known.radius);
   if (!std::isfinite(e.across)) return;
   const double um = 1e6, stored = metres_per_length(twin.experiment()) * um;
-  report << std::setprecision(2) << "  the scans' centres err by " << e.across * um
+  report << std::setprecision(3) << "  the scans' centres err by " << e.across * um
          << " um across the slices and " << e.along_z * um
          << " um along z, from the spread of their contacts against the twin's (" << e.pairs
          << " distances; a contact reads " << std::abs(e.offset) * um << " um "

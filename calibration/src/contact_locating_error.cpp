@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/error.hpp"
 #include "granmem/core/point_index.hpp"
 
 namespace granmem {
@@ -92,9 +94,20 @@ BinnedGaps binned_gaps(const NeighbourGaps& scanned, const NeighbourGaps& refere
 // conditioned on the scanned range. Parameters: offset, ln across, ln along_z (diameters).
 struct ContactSpreadLikelihood {
   const BinnedGaps& b;
+  // erf(b) - erf(a), a < b, from the tail on their side where both lie in one: the plain
+  // difference cancels to nothing there, and a distance far from the reference's would
+  // weigh nothing, without a gradient.
+  template <typename T>
+  static T erf_difference(const T& a, const T& b) {
+    using std::erf, std::erfc;
+    if (a > T(0)) return erfc(a) - erfc(b);
+    if (b < T(0)) return erfc(-b) - erfc(-a);
+    return erf(b) - erf(a);
+  }
+
   template <typename T>
   bool operator()(const T* p, T* cost) const {
-    using std::erf, std::exp, std::log, std::sqrt;
+    using std::exp, std::log, std::sqrt;
     const T across2 = exp(T(2) * p[1]), along2 = exp(T(2) * p[2]);
     cost[0] = T(0);
     for (std::size_t k = 0; k < b.counts.size(); ++k) {
@@ -103,10 +116,10 @@ struct ContactSpreadLikelihood {
       std::vector<T> prob(b.counts[k].size(), T(0));
       for (std::size_t m = 0; m < b.reference_gap.size(); ++m) {
         const T centre = b.reference_gap[m] + p[0];
-        T below = erf((b.edges[0] - centre) * inv);
+        T below = (b.edges[0] - centre) * inv;
         for (std::size_t j = 0; j < prob.size(); ++j) {
-          const T above = erf((b.edges[j + 1] - centre) * inv);
-          prob[j] += b.reference_count[m] * (above - below);
+          const T above = (b.edges[j + 1] - centre) * inv;
+          prob[j] += b.reference_count[m] * erf_difference(below, above);
           below = above;
         }
       }
@@ -164,8 +177,8 @@ ContactLocatingError contact_error(const NeighbourGaps& scan, const NeighbourGap
   const ContactLocatingError scout = fitted_contact_error(scan, ref, diameter, kScout);
   if (!std::isfinite(scout.across)) return scout;
   const double spread = std::sqrt(2.0) * std::max(scout.across, scout.along_z) / diameter;
-  const GapRange range{std::clamp(6 * spread, o.below, kScout.below),
-                       std::clamp(3 * spread, o.above, kScout.above), o.bins, o.directions};
+  const GapRange range{std::min(std::max(6 * spread, o.below), kScout.below),
+                       std::min(std::max(3 * spread, o.above), kScout.above), o.bins, o.directions};
   return fitted_contact_error(scan, ref, diameter, range);
 }
 
@@ -180,9 +193,18 @@ NeighbourGaps gaps_of_every_frame(const TrajectoryReader& run, double diameter, 
 
 }  // namespace
 
+void ContactErrorOptions::validate(double diameter) const {
+  if (!(diameter > 0) || !std::isfinite(diameter))
+    throw Error("the contacts' error: a grain diameter above 0, not " + std::to_string(diameter));
+  if (!(below > 0 && below <= kScout.below && above > 0 && above <= kScout.above))
+    throw Error("the contacts' error: a range within 0.75-1.05 diameters");
+  if (bins < 10 || directions < 1) throw Error("the contacts' error: 10 bins or more, a direction");
+}
+
 ContactLocatingError locating_error_from_contacts(const Vectors3& scanned,
                                                   const Vectors3& reference, double diameter,
                                                   const ContactErrorOptions& options) {
+  options.validate(diameter);
   const double reach = kScout.below + kScout.above;
   NeighbourGaps scan, ref;
   add_neighbour_gaps(scanned, diameter, reach, scan);
@@ -194,6 +216,7 @@ ContactLocatingError locating_error_from_contacts(const TrajectoryReader& scans,
                                                   const TrajectoryReader& reference,
                                                   double diameter,
                                                   const ContactErrorOptions& options) {
+  options.validate(diameter);
   const double reach = kScout.below + kScout.above;
   return contact_error(gaps_of_every_frame(scans, diameter, reach),
                        gaps_of_every_frame(reference, diameter, reach), diameter, options);

@@ -20,12 +20,12 @@ namespace {
 // 2,500 tracks, 0.43-0.70 d from a placed grain), or a grain that cannot be placed there.
 Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double reach) {
   Frame f = run.read_frame(frame);
-  auto missing = [&] {
+  std::vector<bool> taken(std::size_t(f.position.rows()), false);
+  auto missing = [&] {  // a grain no later frame has decided yet
     for (Eigen::Index i = 0; i < f.position.rows(); ++i)
-      if (!f.position.row(i).allFinite()) return true;
+      if (!f.position.row(i).allFinite() && !taken[std::size_t(i)]) return true;
     return false;
   };
-  std::vector<bool> taken(std::size_t(f.position.rows()), false);
   for (std::size_t t = frame + 1; t < run.frame_count() && missing(); ++t) {
     const Frame later = run.read_frame(t);
     const PointIndex placed(finite_rows(f.position));

@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "granmem/core/error.hpp"
 #include "granmem/core/random.hpp"
 #include "granmem/sim/deposit.hpp"
 
@@ -86,12 +87,32 @@ TEST_F(ContactLocatingErrorTest, ReadsAScansErrorsAcrossTheSlicesAndAlongZApart)
   EXPECT_NEAR(harsh.along_z, 190e-6, 25e-6);
 }
 
+TEST_F(ContactLocatingErrorTest, ContactsReadShortAreAnOffsetNotASpread) {
+  // The scanned packing shrunk by 1e-3 about its centre: every contact reads 5 um short.
+  const Eigen::RowVector3d centre = packing_->colwise().mean();
+  Vectors3 shrunk = *packing_;
+  for (Eigen::Index i = 0; i < shrunk.rows(); ++i)
+    shrunk.row(i) = centre + (1 - 1e-3) * (shrunk.row(i) - centre);
+  const ContactLocatingError e =
+      locating_error_from_contacts(scanned(shrunk, 10e-6, 20e-6, 4, 15), *reference_, kDiameter);
+  EXPECT_NEAR(e.offset, -5e-6, 1.5e-6);
+  EXPECT_NEAR(e.across, 10e-6, 1.5e-6);
+  EXPECT_NEAR(e.along_z, 20e-6, 2.5e-6);
+}
+
 TEST_F(ContactLocatingErrorTest, AnExactPackingReadsLessThanItsOverlaps) {
   // Another pour's exact centres: what is left is the two packings' overlaps differing
   // (~1e-3 d under the lid), not an error.
   const ContactLocatingError e = locating_error_from_contacts(*packing_, *reference_, kDiameter);
   EXPECT_LT(e.across, 2.5e-6);
   EXPECT_LT(e.along_z, 2.5e-6);
+}
+
+TEST_F(ContactLocatingErrorTest, RefusesARangeOutsideItsReachAndNoDiameter) {
+  ContactErrorOptions wide;
+  wide.below = 0.4;
+  EXPECT_THROW(locating_error_from_contacts(*packing_, *reference_, kDiameter, wide), Error);
+  EXPECT_THROW(locating_error_from_contacts(*packing_, *reference_, 0.0), Error);
 }
 
 TEST_F(ContactLocatingErrorTest, TooFewContactsReadNothing) {

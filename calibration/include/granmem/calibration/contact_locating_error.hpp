@@ -12,8 +12,8 @@ namespace granmem {
 // diameter apart, less overlaps of ~1e-3 d under the lid, so the scanned distances of
 // touching neighbours spread about a diameter by the two centres' errors along the
 // contact. Locate's standard errors come from its fit's residuals and miss what a grain's
-// neighbourhood in the image does to it, the same from scan to scan (they are a third to a
-// half of the errors against a render's truth, docs/CALIBRATION.md); the contacts see it,
+// neighbourhood in the image does to it, the same from scan to scan (a sixth to a half of
+// the errors against a render's truth, docs/CALIBRATION.md); the contacts see it,
 // and it is what moves the packing's structure, or a packing placed where the scan has
 // its grains.
 //
@@ -23,15 +23,20 @@ namespace granmem {
 // `offset`: a maximum likelihood over the distances near contact, binned by |u_z|, each
 // bin's distances conditioned on lying in the range fitted (grains the scan missed change
 // how many there are, not their spread). The range is found from the data: a first fit
-// over 0.75-1.05 d, then six and three times a contact's spread below and above. Errors
+// over 0.75-1.05 d, then six and three times a contact's spread below and above, within
+// 0.75-1.05 d (a coarse scan's is then the first range again, in finer bins). Errors
 // that touching neighbours share cancel in a distance, as they do in the structure:
 // `across` and `along_z` are one centre's independent part, of the errors' normal core: a
-// grain located beyond the range (a coarse scan's stray) does not count in it.
+// grain located beyond the range (a coarse scan's stray) does not count in it. Grains of
+// unequal size spread their contacts too: on real grains it is the locating error and the
+// size spread together (radii spread by 1 % add ~0.007 d to a contact's spread).
 struct ContactErrorOptions {
   double below = 0.03;  // the range fitted at least from (1 - below) d
   double above = 0.01;  // to (1 + above) d
   int bins = 80;        // of the distances in the range
   int directions = 5;   // bins of |u_z|, each an equal solid angle
+  // Error for a diameter not above 0, a range outside 0.75-1.05 d, fewer than 10 bins.
+  void validate(double diameter) const;
 };
 
 struct ContactLocatingError {

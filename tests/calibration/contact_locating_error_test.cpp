@@ -8,8 +8,11 @@
 #include <cmath>
 
 #include "granmem/core/error.hpp"
+#include "granmem/core/point_index.hpp"
 #include "granmem/core/random.hpp"
+#include "granmem/core/trajectory_store.hpp"
 #include "granmem/sim/deposit.hpp"
+#include "temp_dir.hpp"
 
 namespace granmem {
 namespace {
@@ -48,7 +51,7 @@ Vectors3 scanned(const Vectors3& exact, double across, double along_z, int copie
   return scans;
 }
 
-class ContactLocatingErrorTest : public testing::Test {
+class ContactLocatingErrorTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     packing_ = new Vectors3(poured(3));
@@ -106,6 +109,50 @@ TEST_F(ContactLocatingErrorTest, AnExactPackingReadsLessThanItsOverlaps) {
   const ContactLocatingError e = locating_error_from_contacts(*packing_, *reference_, kDiameter);
   EXPECT_LT(e.across, 2.5e-6);
   EXPECT_LT(e.along_z, 2.5e-6);
+}
+
+// The stores calibrate reads: scans in mm with grains unlocated in some frames, the twin's
+// run in m; frames pooled, read as the positions are.
+class ContactLocatingErrorStores : public testing::TempDirTest {};
+
+TEST_F(ContactLocatingErrorStores, ReadsTheScansFramesInTheirUnit) {
+  const Vectors3 exact = poured(3), reference = poured(4);
+  Trajectories scans, twin;
+  scans.header.length_unit = "mm";
+  twin.header.length_unit = "m";
+  for (Trajectories* run : {&scans, &twin}) {
+    const Eigen::Index n = run == &scans ? exact.rows() : reference.rows();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      run->header.id.push_back(i + 1);
+      run->header.radius.push_back(run == &scans ? 2.5 : 2.5e-3);
+    }
+  }
+  Vectors3 pooled(0, 3);
+  for (int t = 0; t < 3; ++t) {
+    Frame f = Frame::unknown(scans.header);
+    f.step = t;
+    f.position = scanned(exact, 10e-6, 20e-6, 1, 20 + t);
+    f.position.row(7 * t).setConstant(NAN);  // not located in this scan
+    pooled.conservativeResize(pooled.rows() + f.position.rows(), 3);
+    pooled.bottomRows(f.position.rows()) = f.position;
+    pooled.bottomRows(f.position.rows()).col(0).array() += 0.2 * t;  // frames apart
+    f.position *= 1e3;
+    scans.frames.push_back(f);
+  }
+  Frame r = Frame::unknown(twin.header);
+  r.position = reference;
+  twin.frames.push_back(r);
+  write_trajectories(path("scans.h5"), scans);
+  write_trajectories(path("twin.h5"), twin);
+  const ContactLocatingError from_stores = locating_error_from_contacts(
+      TrajectoryReader(path("scans.h5")), TrajectoryReader(path("twin.h5")), kDiameter);
+  const ContactLocatingError from_positions =
+      locating_error_from_contacts(finite_rows(pooled), reference, kDiameter);
+  EXPECT_EQ(from_stores.pairs, from_positions.pairs);
+  EXPECT_NEAR(from_stores.across, from_positions.across, 1e-9);
+  EXPECT_NEAR(from_stores.along_z, from_positions.along_z, 1e-9);
+  EXPECT_NEAR(from_stores.across, 10e-6, 1.5e-6);
+  EXPECT_NEAR(from_stores.along_z, 20e-6, 2.5e-6);
 }
 
 TEST_F(ContactLocatingErrorTest, RefusesARangeOutsideItsReachAndNoDiameter) {

@@ -45,6 +45,8 @@ for s in steps:
 rms = lambda x: np.sqrt(np.mean(np.vstack(x) ** 2, 0))
 print(f"{sys.argv[1]}: {ok.sum()} grains matched, scans {steps[0]}-{steps[-1]}; voxels, x y z")
 print("position error RMS              ", rms(pos).round(4))
+print("|position error| median, 99th %", [np.quantile(np.abs(np.vstack(pos)), q, 0).round(4)
+                                         for q in (0.5, 0.99)])
 print("its standard error RMS          ", rms([sigma(s)[ok] for s in steps]).round(4))
 print("displacement error RMS          ", rms(disp).round(4))
 print("predicted, sqrt(s_a^2 + s_b^2)  ", rms(pred).round(4))

@@ -94,20 +94,19 @@ BinnedGaps binned_gaps(const NeighbourGaps& scanned, const NeighbourGaps& refere
 // conditioned on the scanned range. Parameters: offset, ln across, ln along_z (diameters).
 struct ContactSpreadLikelihood {
   const BinnedGaps& b;
-  // erf(b) - erf(a), a < b, from the tail on their side where both lie in one: the plain
-  // difference cancels to nothing there, and a distance far from the reference's would
-  // weigh nothing, without a gradient.
+  // erf(b) - erf(a), a < b, from each edge's tail, erfc(|x|): where both edges lie on one
+  // side the plain difference cancels to nothing, and a distance far from the reference's
+  // would weigh nothing, without a gradient.
   template <typename T>
-  static T erf_difference(const T& a, const T& b) {
-    using std::erf, std::erfc;
-    if (a > T(0)) return erfc(a) - erfc(b);
-    if (b < T(0)) return erfc(-b) - erfc(-a);
-    return erf(b) - erf(a);
+  static T erf_difference(const T& a, const T& tail_a, const T& b, const T& tail_b) {
+    if (a > T(0)) return tail_a - tail_b;
+    if (b < T(0)) return tail_b - tail_a;
+    return T(2) - tail_a - tail_b;
   }
 
   template <typename T>
   bool operator()(const T* p, T* cost) const {
-    using std::exp, std::log, std::sqrt;
+    using std::abs, std::erfc, std::exp, std::log, std::sqrt;
     const T across2 = exp(T(2) * p[1]), along2 = exp(T(2) * p[2]);
     cost[0] = T(0);
     for (std::size_t k = 0; k < b.counts.size(); ++k) {
@@ -116,11 +115,12 @@ struct ContactSpreadLikelihood {
       std::vector<T> prob(b.counts[k].size(), T(0));
       for (std::size_t m = 0; m < b.reference_gap.size(); ++m) {
         const T centre = b.reference_gap[m] + p[0];
-        T below = (b.edges[0] - centre) * inv;
+        T below = (b.edges[0] - centre) * inv, below_tail = erfc(abs(below));
         for (std::size_t j = 0; j < prob.size(); ++j) {
-          const T above = (b.edges[j + 1] - centre) * inv;
-          prob[j] += b.reference_count[m] * erf_difference(below, above);
+          const T above = (b.edges[j + 1] - centre) * inv, above_tail = erfc(abs(above));
+          prob[j] += b.reference_count[m] * erf_difference(below, below_tail, above, above_tail);
           below = above;
+          below_tail = above_tail;
         }
       }
       T total = T(0);

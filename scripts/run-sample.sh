@@ -26,7 +26,8 @@ step "1/5 the sample table of tracked grains"
 "$granmem" --config $config analyze "$out/run.h5" --out "$out/analysis"
 
 step "2/5 pseudo-experiment: DEM at mu_s = $TRUE_MU_S (seed 101), scans of each cycle's end"
-"$granmem" --config $config simulate --mu-s $TRUE_MU_S --seed 101 --out "$out/experiment_dem.h5"
+"$granmem" --config $config simulate --mu-s $TRUE_MU_S --seed 101 --threads 2 \
+  --out "$out/experiment_dem.h5"
 render() {  # one scan of the end of cycle $1
   "$granmem" --config $config render "$out/experiment_dem.h5" --frame "$1" --seed $(($1 + 1)) \
     --out "$out/scans/scan$1.tif" --truth "$out/scans/truth$1.csv" > "$out/scans/render$1.log"

@@ -507,16 +507,18 @@ class Twin {
     const int at_once =
         series_.parallel > 0 ? series_.parallel : int(std::thread::hardware_concurrency());
     say(std::to_string(todo.size()) + " runs, " + std::to_string(at_once) + " at once");
-    auto start = [&](const FrictionRunSpec& spec) {
+    auto start = [&](const FrictionRunSpec& spec, int cores) {
       if (o_.preparation == TwinPreparation::shared) {
         return with_frictions(shared_.at(spec.seed), spec, series_.walls_follow);
       }
       if (o_.preparation == TwinPreparation::experiment) {
-        return settled_packing(jittered(*placed_, placed_jitter_, spec.seed, deposit_), deposit_,
+        DepositOptions settling = deposit_;
+        settling.threads = Simulation::threads_on_own_cores(placed_->size(), cores);
+        return settled_packing(jittered(*placed_, placed_jitter_, spec.seed, deposit_), settling,
                                with_frictions(physics_, spec, series_.walls_follow),
                                GrainPlacement::at_rest);
       }
-      return deposit_at_friction(deposit_, physics_, spec, series_.walls_follow);
+      return deposit_at_friction(deposit_, physics_, spec, series_.walls_follow, cores);
     };
     run_friction_series(todo, series_, start, [&](std::size_t k, const CyclicProgress& p) {
       if (o_.progress) o_.progress(todo[k], p);

@@ -29,8 +29,9 @@ Simulation with_frictions(const Simulation& packing, const FrictionRunSpec& run,
 }
 
 Simulation deposit_at_friction(DepositOptions deposit, const PhysicsOptions& physics,
-                               const FrictionRunSpec& run, bool walls_follow) {
+                               const FrictionRunSpec& run, bool walls_follow, int cores) {
   deposit.seed = run.seed;
+  deposit.threads = Simulation::threads_on_own_cores(std::size_t(deposit.grains), cores);
   return granmem::deposit(deposit, with_frictions(physics, run, walls_follow));
 }
 
@@ -49,7 +50,7 @@ std::filesystem::path friction_run_path(const std::filesystem::path& dir,
 
 std::vector<std::filesystem::path> run_friction_series(
     const std::vector<FrictionRunSpec>& runs, const FrictionSeriesOptions& options,
-    const std::function<Simulation(const FrictionRunSpec&)>& start,
+    const std::function<Simulation(const FrictionRunSpec&, int)>& start,
     const std::function<void(std::size_t, const CyclicProgress&)>& progress) {
   if (runs.empty()) throw Error("friction series: no mu_s values");
   for (const FrictionRunSpec& r : runs) {
@@ -61,9 +62,9 @@ std::vector<std::filesystem::path> run_friction_series(
   for (const FrictionRunSpec& r : runs)
     out.push_back(friction_run_path(options.dir, r));
   std::mutex report;
-  run_pool(runs.size(), {options.parallel, options.stop}, [&](std::size_t k) {
-    Simulation sim = start(runs[k]);
-    sim.set_threads(1);  // parallel over runs: one thread each
+  run_pool(runs.size(), {options.parallel, options.stop}, [&](std::size_t k, int cores) {
+    Simulation sim = start(runs[k], cores);
+    sim.set_threads(Simulation::threads_on_own_cores(sim.grains().size(), cores));
     CyclicOptions c = options.protocol;
     c.out = out[k];
     c.checkpoint.clear();

@@ -130,6 +130,7 @@ Simulation settled_packing(Grains grains, const DepositOptions& o, const Physics
   box.size = {o.box_side, o.box_side};
 
   Simulation sim(std::move(grains), box, physics);
+  sim.set_threads(o.threads);
   double settling = placement == GrainPlacement::poured ? settle(sim, o, "falling", progress) : 0.0;
 
   if (o.lid_mass > 0) {

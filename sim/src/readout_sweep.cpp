@@ -215,10 +215,10 @@ ReadoutSweepSummary run_readout_sweep(
   std::mutex report;
   std::size_t done = summary.runs.size() - todo.size();
   const auto sweep_start = std::chrono::steady_clock::now();
-  run_pool(todo.size(), o.pool, [&](std::size_t t) {
+  run_pool(todo.size(), o.pool, [&](std::size_t t, int cores) {
     const std::size_t k = todo[t];
     Simulation sim = states[summary.runs[k].state].sim;
-    sim.set_threads(1);  // parallel over runs: one thread each
+    sim.set_threads(Simulation::threads_on_own_cores(sim.grains().size(), cores));
     ProtocolState fresh;
     run_cycles(sim, protocol[k], fresh);
     const std::lock_guard<std::mutex> lock(report);

@@ -13,7 +13,7 @@
 namespace granmem {
 
 RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
-                        const std::function<void(std::size_t)>& run) {
+                        const std::function<void(std::size_t, int)>& run) {
   const Ranks ranks = mpi_ranks();
   mpi_barrier();  // every rank has planned the same runs before any run writes
   std::vector<std::size_t> mine;
@@ -23,20 +23,33 @@ RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
       std::max(1, int(std::thread::hardware_concurrency()) / std::max(1, ranks.on_node));
   const int workers = int(std::min<std::size_t>(
       mine.size(), std::size_t(options.parallel > 0 ? options.parallel : cores)));
+  const int share = std::max(1, cores / std::max(1, workers));
   std::atomic<std::size_t> next{0}, done{0};
-  std::mutex failed;
+  std::mutex failed, dealing;
   std::exception_ptr failure;
+  int cores_in_use = 0;
+  // The last runs dealt take the cores of the workers left with nothing to do.
+  auto deal = [&](std::size_t t) {
+    const std::lock_guard<std::mutex> lock(dealing);
+    const bool tail = mine.size() - t < std::size_t(workers);
+    const int run_cores = tail ? std::max(share, cores - cores_in_use) : share;
+    cores_in_use += run_cores;
+    return run_cores;
+  };
   auto stopped = [&] { return options.stop && options.stop->load(); };
   auto work = [&] {
     for (std::size_t t; !stopped() && (t = next++) < mine.size();) {
+      const int run_cores = deal(t);
       try {
-        run(mine[t]);
+        run(mine[t], run_cores);
         ++done;
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failed);
         if (!failure) failure = std::current_exception();
         next = mine.size();
       }
+      const std::lock_guard<std::mutex> lock(dealing);
+      cores_in_use -= run_cores;
     }
   };
   std::vector<std::thread> pool;

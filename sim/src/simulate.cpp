@@ -154,7 +154,8 @@ SimulateSummary simulate(const SimulateOptions& o) {
   Start start = start_of(o, log);
   RunSettings& v = start.settings;
   const PhysicsOptions physics = physics_from(v);
-  const DepositOptions d = deposit_from(v);
+  DepositOptions d = deposit_from(v);
+  d.threads = o.threads;
   d.validate();  // before any work or output
   physics.validate("simulate", d.radius * (1 - d.polydispersity));
   // Every setting is checked before the packing is made.

@@ -113,6 +113,10 @@ void Simulation::set_threads(int threads) {
   wall_touchers_.assign(std::size_t(threads_), {});
 }
 
+int Simulation::threads_on_own_cores(std::size_t grains, int cores) {
+  return std::clamp(int(grains / kGrainsPerOwnCore), 1, std::max(1, cores));
+}
+
 void Simulation::rebuild_neighbors() {
   NeighborList next(physics_.skin);
   next.set_threads(threads_);

@@ -38,8 +38,8 @@ class FrictionSeriesTest : public testing::TempDirTest {
     o.dir = path(dir);
     std::filesystem::create_directories(o.dir);
     o.parallel = parallel;
-    return run_friction_series(specs, o, [&](const FrictionRunSpec& spec) {
-      return deposit_at_friction(deposit_, physics_, spec, o.walls_follow);
+    return run_friction_series(specs, o, [&](const FrictionRunSpec& spec, int cores) {
+      return deposit_at_friction(deposit_, physics_, spec, o.walls_follow, cores);
     });
   }
   PhysicsOptions physics_;

@@ -2,6 +2,7 @@
 // run's error passed on after the dealing stops.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
@@ -18,7 +19,7 @@ TEST(RunPool, RunsEveryRunOnceAndNoMoreAtOnceThanAsked) {
     for (std::size_t count : {0, 1, 7}) {
       std::vector<std::atomic<int>> calls(count);
       std::atomic<int> running{0}, most{0};
-      const RunPoolSummary s = run_pool(count, {parallel}, [&](std::size_t k) {
+      const RunPoolSummary s = run_pool(count, {parallel}, [&](std::size_t k, int) {
         const int now = ++running;
         for (int m = most; now > m && !most.compare_exchange_weak(m, now);) {
         }
@@ -35,10 +36,29 @@ TEST(RunPool, RunsEveryRunOnceAndNoMoreAtOnceThanAsked) {
   }
 }
 
+// The cores given to the runs under way never add up to more than the machine's (or one
+// each, where more runs are asked at once than it has); a run alone gets them all.
+TEST(RunPool, TheRunsUnderWayShareTheCoresAndARunAloneGetsThemAll) {
+  const int machine = std::max(1, int(std::thread::hardware_concurrency()));
+  run_pool(1, {}, [&](std::size_t, int cores) { EXPECT_EQ(cores, machine); });
+  for (int parallel : {1, 2, 3}) {
+    std::atomic<int> in_use{0}, most{0};
+    run_pool(9, {parallel}, [&](std::size_t k, int cores) {
+      EXPECT_GE(cores, 1);
+      const int now = in_use += cores;
+      for (int m = most; now > m && !most.compare_exchange_weak(m, now);) {
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2 + 3 * int(k % 3)));
+      in_use -= cores;
+    });
+    EXPECT_LE(most, std::max(machine, parallel)) << parallel << " at once";
+  }
+}
+
 TEST(RunPool, AFailingRunStopsTheDealingAndItsErrorIsPassedOn) {
   std::atomic<int> started{0};
   EXPECT_THROW(run_pool(10, {1},
-                        [&](std::size_t k) {
+                        [&](std::size_t k, int) {
                           ++started;
                           if (k == 2) throw std::runtime_error("run 2 failed");
                         }),

@@ -26,6 +26,7 @@ struct DepositOptions {
   double settled_energy = 1e-13;
   double settling_damping = 5.0;  // background drag rate while settling, 1/s
   double max_settling_time = 10;  // s, per stage; not settled by then is an error
+  int threads = 0;  // of its simulation: Simulation::set_threads (0: by the number of grains)
 
   // Throws Error for no grains, more grains than half this machine's memory holds, a
   // radius or polydispersity out of range, a box narrower than three grains, a negative lid.

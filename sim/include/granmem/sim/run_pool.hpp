@@ -23,16 +23,18 @@ struct RunPoolSummary {
   int ranks = 1;         // processes of the MPI job that shared the runs
 };
 
-// Calls run(k) for every k in [0, count), `parallel` at a time, each on a thread of its own
-// (a run sets its simulation to one thread). Runs are dealt in the order of k as workers
-// free up. The first exception thrown by a run stops the dealing; the runs under way are
-// finished, and the exception is rethrown.
+// Calls run(k, cores) for every k in [0, count), `parallel` at a time, each on a thread of
+// its own; `cores`: those the run may use, the machine's shared among the workers, and a
+// run dealt when fewer are left than workers also those of the workers already idle (the
+// last of a series, or a single run, need not leave cores unused). Runs are dealt in the
+// order of k as workers free up. The first exception thrown by a run stops the dealing; the runs
+// under way are finished, and the exception is rethrown.
 //
 // In an MPI job (ranks.hpp) every rank calls run_pool with the same runs; rank r does runs
 // r, r + size, ... and all return together once every run is done, so that rank 0 may then
 // read what every run wrote (to a shared file system). A run that fails on one rank makes
 // run_pool throw on every rank. A run's result does not depend on where it ran.
 RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
-                        const std::function<void(std::size_t)>& run);
+                        const std::function<void(std::size_t, int)>& run);
 
 }  // namespace granmem

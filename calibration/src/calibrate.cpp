@@ -747,19 +747,42 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
   return fo;
 }
 
-// An observable from positions that the scans' own locating noise moves by more than
-// kNoiseShare of one packing's scatter: the twin's positions are exact, so it would pull
-// the fit by the scans' noise, not by friction (a contact count within a 2 % gap, at a
-// locating error of 1 % of a diameter). Measured by moving the experiment's positions by
-// their own standard errors once more; as a scan's position error is 2-3x its standard
-// error (docs/BENCHMARKS.md), the share is small. The rotation likewise, by tilting its
-// axes once more, but where the twin's axes get the same noise only its size's error,
-// ~10 % (docs/BENCHMARKS.md), can bias the fit: ~20 % of the noise's part where that part
-// grows as sigma^2 (a rotation the noise dominates), less where it grows more slowly; so
-// the rotation is left out where kModelledNoise of the move could exceed one packing's
-// scatter (the noise then most of what is measured). Without noise in the twin's axes
-// (--axis-noise 0) it is judged as the positions are.
+// The scans' locating error read from their contacts (contact_locating_error.hpp) against
+// the twin's run nearest `mu_s`: for scans of grains known to be alike (a simulated
+// experiment's positions are exact), against a poured twin (one placed from the scans
+// starts from their errors); NaN errors elsewhere. In metres.
+ContactLocatingError contacts_locating_error(const Twin& twin,
+                                             const std::vector<SteadyStateRun>& runs, double mu_s) {
+  const KnownGrains known = twin.known_grains();
+  if (!twin.experiment().header().voxel_size || !known.radius || runs.empty() ||
+      twin.options().preparation == TwinPreparation::experiment)
+    return {};
+  const auto nearest = std::min_element(runs.begin(), runs.end(), [&](auto& a, auto& b) {
+    return std::abs(std::log(a.mu_s / mu_s)) < std::abs(std::log(b.mu_s / mu_s));
+  });
+  const FrictionRunSpec spec{nearest->mu_s, nearest->seed, nearest->mu_r};
+  return locating_error_from_contacts(twin.experiment(), TrajectoryReader(twin.path(spec)),
+                                      2 * *known.radius);
+}
+
+// An observable from positions that the scans' own locating noise moves by more than a
+// share of one packing's scatter: the twin's positions are exact, so it would pull the fit
+// by the scans' noise, not by friction (a contact count within a 2 % gap, at a locating
+// error of 1 % of a diameter). Measured by moving the experiment's positions by their
+// error once more: where the scans' contacts give it, their actual error, and the
+// observable is left out where that moves it by more than one packing's scatter (the
+// experiment's own realization, which the interval already carries); elsewhere by locate's
+// standard errors, which a scan's actual error exceeds 2-3x (docs/BENCHMARKS.md), so by a
+// quarter of a scatter (the effects grow as sigma^2: 1-2 scatters at the actual error).
+// The rotation likewise, by tilting its axes once more, but where the twin's axes get the
+// same noise only its size's error, ~10 % (docs/BENCHMARKS.md), can bias the fit: ~20 % of
+// the noise's part where that part grows as sigma^2 (a rotation the noise dominates), less
+// where it grows more slowly; so the rotation is left out where kModelledNoise of the move
+// could exceed one packing's scatter (the noise then most of what is measured). Without
+// noise in the twin's axes (--axis-noise 0) it is judged as the positions are by their
+// standard errors.
 constexpr double kNoiseShare = 0.25;
+constexpr double kContactsNoiseShare = 1.0;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
   std::string name;
@@ -768,10 +791,24 @@ struct NoiseLimited {
   bool dropped = true;  // false: kept, as the fit needs more observables than the rest
 };
 
+// What the scans' noise does to the fit: the observables it leaves out, and the contacts'
+// error where it was measured with it.
+struct ScanNoise {
+  std::vector<NoiseLimited> limited;
+  ContactLocatingError contacts;
+};
+
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
-                                        const std::vector<double>& scatter) {
+                                        const std::vector<double>& scatter,
+                                        const ContactLocatingError& contacts) {
+  Eigen::Vector3d e = twin.errors.position;
+  double share = kNoiseShare;
+  if (std::isfinite(contacts.across) && std::isfinite(contacts.along_z)) {
+    e = Eigen::Vector3d(contacts.across, contacts.across, contacts.along_z) /
+        metres_per_length(twin.experiment());
+    share = kContactsNoiseShare;
+  }
   SteadyState effect;
-  const Eigen::Vector3d e = twin.errors.position;
   if (e.allFinite() && !e.isZero()) {
     effect =
         structure_noise_effect(twin.experiment(), twin.observe.window, e, {}, twin.known_grains());
@@ -789,86 +826,80 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
     const bool rotation_k = names[k] == "rot_disp";
     const bool modelled = rotation_k && twin.observe.axis_noise > 0;
     const double d = rotation_k ? rotation : effect[names[k]];
-    if (std::isfinite(d) && (modelled ? kModelledNoise * std::abs(d) > scatter[k]
-                                      : std::abs(d) > kNoiseShare * scatter[k]))
+    if (std::isfinite(d) && (modelled     ? kModelledNoise * std::abs(d) > scatter[k]
+                             : rotation_k ? std::abs(d) > kNoiseShare * scatter[k]
+                                          : std::abs(d) > share * scatter[k]))
       limited.push_back({names[k], d, scatter[k], modelled});
   }
   return limited;
 }
 
 // The fit again without the observables the scans' noise moves, unless they were chosen
-// with --only; `fewest`: the observables the fit needs.
+// with --only; `fewest`: the observables the fit needs. The contacts' error is read against
+// the run nearest the first fit.
 template <class Fit, class Refit>
-Fit without_noise_limited(const Twin& twin, Fit fit, Refit refit, std::size_t fewest,
-                          std::vector<NoiseLimited>* left_out) {
-  if (!twin.options().only.empty()) return fit;
-  std::vector<NoiseLimited> limited = noise_limited(twin, fit.names, fit.scatter);
+Fit without_noise_limited(const Twin& twin, const std::vector<SteadyStateRun>& runs, Fit fit,
+                          Refit refit, std::size_t fewest, ScanNoise* noise) {
+  ScanNoise found;
+  found.contacts = contacts_locating_error(twin, runs, fit.mu_s);
+  if (twin.options().only.empty())
+    found.limited = noise_limited(twin, fit.names, fit.scatter, found.contacts);
   std::vector<std::string> kept;
   for (const std::string& name : fit.names) {
-    if (std::none_of(limited.begin(), limited.end(),
+    if (std::none_of(found.limited.begin(), found.limited.end(),
                      [&](const NoiseLimited& l) { return l.name == name; }))
       kept.push_back(name);
   }
-  const bool refit_without = !limited.empty() && kept.size() >= fewest;
-  for (NoiseLimited& l : limited)
+  const bool refit_without = !found.limited.empty() && kept.size() >= fewest;
+  for (NoiseLimited& l : found.limited)
     l.dropped = refit_without;
-  if (left_out) *left_out = limited;
+  if (noise) *noise = found;
   return refit_without ? refit(kept) : fit;
 }
 
 ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
-                               std::vector<NoiseLimited>* left_out = nullptr) {
+                               ScanNoise* noise = nullptr) {
   const CalibrateOptions& o = twin.options();
   auto fit = [&](const std::vector<std::string>& names) {
     return fit_friction_to_steady_state(twin.measured_steady_state(), runs,
                                         observable_fit_options(o), names);
   };
-  return without_noise_limited(twin, fit(o.only), fit, 1, left_out);
+  return without_noise_limited(twin, runs, fit(o.only), fit, 1, noise);
 }
 
 JointObservableFit joint_steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
-                                          std::vector<NoiseLimited>* left_out = nullptr) {
+                                          ScanNoise* noise = nullptr) {
   const CalibrateOptions& o = twin.options();
   auto fit = [&](const std::vector<std::string>& names) {
     return fit_frictions_to_steady_state(twin.measured_steady_state(), runs,
                                          observable_fit_options(o), names);
   };
-  return without_noise_limited(twin, fit(o.only), fit, 2, left_out);
+  return without_noise_limited(twin, runs, fit(o.only), fit, 2, noise);
 }
 
 // The report's lines on the observables left out, and why; their names for summary.json.
-void report_noise_limited(const std::vector<NoiseLimited>& limited, std::ostream& report,
-                          JsonObject& j) {
+void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObject& j) {
   std::vector<std::string> names;
-  for (const NoiseLimited& l : limited) {
+  const bool contacts = std::isfinite(noise.contacts.across);
+  for (const NoiseLimited& l : noise.limited) {
+    const bool rotation = l.name == "rot_disp";
     report << std::setprecision(3) << "  note: " << l.name
            << (l.dropped ? " left out" : " kept, as the fit needs it,") << ": the scans' own "
-           << (l.name == "rot_disp" ? "axis" : "locating") << " noise moves it by " << l.effect
-           << " (one packing's scatter " << l.scatter << ")"
-           << (l.modelled             ? ", more than the twin's tilted axes model"
-               : l.name == "rot_disp" ? " and the twin's axes are exact"
-                                      : " and the twin's positions are exact")
+           << (rotation ? "axis" : "locating") << " noise"
+           << (!rotation && contacts ? " (their contacts' error)" : "") << " moves it by "
+           << l.effect << " (one packing's scatter " << l.scatter << ")"
+           << (l.modelled ? ", more than the twin's tilted axes model"
+               : rotation ? " and the twin's axes are exact"
+                          : " and the twin's positions are exact")
            << (l.dropped ? " (--only keeps it)\n" : "\n");
     if (l.dropped) names.push_back(l.name);
   }
   j["left_out_for_scan_noise"] = names;
 }
 
-// The scans' locating error read from their contacts against the twin's run nearest the
-// fit (contact_locating_error.hpp): what locate's standard errors miss, said beside them,
-// for scans of grains known to be alike (a simulated experiment's positions are exact),
-// against a poured twin (one placed from the scans starts from their errors).
-void report_contact_error(const Twin& twin, const std::vector<FrictionRunSpec>& specs, double mu_s,
-                          std::ostream& report, JsonObject& j) {
-  const KnownGrains known = twin.known_grains();
-  if (!twin.experiment().header().voxel_size || !known.radius || specs.empty() ||
-      twin.options().preparation == TwinPreparation::experiment)
-    return;
-  const auto nearest = std::min_element(specs.begin(), specs.end(), [&](auto& a, auto& b) {
-    return std::abs(std::log(a.mu_s / mu_s)) < std::abs(std::log(b.mu_s / mu_s));
-  });
-  const ContactLocatingError e = locating_error_from_contacts(
-      twin.experiment(), TrajectoryReader(twin.path(*nearest)), 2 * *known.radius);
+// The scans' locating error read from their contacts, said beside locate's standard errors.
+void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::ostream& report,
+                          JsonObject& j) {
   if (!std::isfinite(e.across)) return;
   const double um = 1e6, stored = metres_per_length(twin.experiment()) * um;
   report << std::setprecision(3) << "  the scans' centres err by " << e.across * um
@@ -903,20 +934,20 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
   std::ostringstream line;
   line << std::setprecision(3) << "the design's fit: ";
   FrictionRunSpec at;
-  std::vector<NoiseLimited> limited;
+  ScanNoise noise;
   if (o.joint()) {
-    const JointObservableFit f = joint_steady_state_fit(twin, runs, &limited);
+    const JointObservableFit f = joint_steady_state_fit(twin, runs, &noise);
     at = {three_digits(f.mu_s), 0, three_digits(f.mu_r)};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << "), mu_r = " << f.mu_r << " (" << f.mu_r_ci95[0] << " - " << f.mu_r_ci95[1] << ")";
   } else {
-    const ObservableFit f = steady_state_fit(twin, runs, &limited);
+    const ObservableFit f = steady_state_fit(twin, runs, &noise);
     at = {three_digits(f.mu_s), 0};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << ")";
   }
   line << ", " << runs.size() << " runs";
-  for (const NoiseLimited& l : limited)
+  for (const NoiseLimited& l : noise.limited)
     if (l.dropped) line << ", without " << l.name << " (the scans' noise)";
   line << "; ";
   return {at, line.str()};
@@ -956,8 +987,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
   const SteadyState measured = twin.measured_steady_state();
-  std::vector<NoiseLimited> limited;
-  const ObservableFit fit = steady_state_fit(twin, runs, &limited);
+  ScanNoise noise;
+  const ObservableFit fit = steady_state_fit(twin, runs, &noise);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed()};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
@@ -995,8 +1026,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["refined"] = specs.size() - o.mu_s.size() * std::size_t(o.replicas);  // 0 at the edge
   j["observables"] = written.observables;
   std::ostringstream left_out;
-  report_noise_limited(limited, left_out, j);
-  report_contact_error(twin, specs, fit.mu_s, left_out, j);
+  report_noise_limited(noise, left_out, j);
+  report_contact_error(twin, noise.contacts, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -1017,8 +1048,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
                std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
-  std::vector<NoiseLimited> limited;
-  const JointObservableFit fit = joint_steady_state_fit(twin, runs, &limited);
+  ScanNoise noise;
+  const JointObservableFit fit = joint_steady_state_fit(twin, runs, &noise);
   const FrictionRunSpec best{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
@@ -1060,8 +1091,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   j["deposit"] = preparation_name(o.preparation);
   j["observables"] = fit.names;
   std::ostringstream left_out;
-  report_noise_limited(limited, left_out, j);
-  report_contact_error(twin, specs, fit.mu_s, left_out, j);
+  report_noise_limited(noise, left_out, j);
+  report_contact_error(twin, noise.contacts, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]

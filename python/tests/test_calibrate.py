@@ -132,6 +132,31 @@ def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experime
     assert "left out" not in kept["report"]
 
 
+def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
+    # Scans in voxels of 0.1 mm whose centres err by 0.2 mm (4 % of a diameter) while their
+    # standard errors say 1 um: the touching neighbours' spread reads the actual error, and
+    # the noise check, measured with it, leaves out the height the noise moves (with the
+    # standard errors alone it would keep it, as for the scans located to 1 um above).
+    voxel, sigma = 1e-4, 2e-4
+    tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
+    lo, hi = granmem.read_run(experiment)["box"]
+    rng = np.random.default_rng(5)
+    for c in ("x", "y", "z"):
+        tracks[c] = (tracks[c] + rng.normal(0, sigma, len(tracks))) / voxel
+        tracks["ep_" + c] = 1e-6 / voxel
+    tracks["radius"] /= voxel
+    tracks.to_csv(tmp_path / "scans.csv", index=False)
+    cli("import", "scans.csv", "--out", "scans.h5", "--voxel-size", "0.1mm",
+        "--container", ",".join(str(v / voxel) for v in (*lo, *hi)))
+    fit = granmem.calibrate(tmp_path / "scans.h5", tmp_path / "cal", **FIT, **TWIN)
+    summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
+    contacts = summary["locating_error_from_contacts"]
+    assert 130 < contacts["across_um"] < 300 and 130 < contacts["along_z_um"] < 300
+    assert "height_packing_fraction" in summary["left_out_for_scan_noise"]
+    assert "height_packing_fraction left out: the scans' own locating noise (their contacts' " \
+        "error) moves it by" in fit["report"]
+
+
 def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):
     # Hole axes known to 30 deg: the measured rotation is the noise's, more than the twin's
     # tilted axes model to the accuracy of that noise's size; known to 1 deg, it is kept.

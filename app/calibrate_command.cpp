@@ -20,6 +20,12 @@ std::vector<std::string> parse_names(const std::string& text) {
   return names;
 }
 
+double one_friction(const std::string& text, const std::string& option) {
+  const std::vector<double> values = parse_frictions(text, option);
+  if (values.size() != 1) throw Error(option + ": one friction, not '" + text + "'");
+  return values.front();
+}
+
 }  // namespace
 
 void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
@@ -31,6 +37,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto";
+    std::string true_mu_s, true_mu_r;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
@@ -91,6 +98,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "first frame exact: cycle 0, every grain), else each")
       ->capture_default_str()
       ->check(CLI::IsMember({"each", "shared", "experiment", "auto"}));
+  cmd->add_option("--true-mu-s", args->true_mu_s,
+                  "the sliding friction a pseudo-experiment was made with, where its store does "
+                  "not say it (scans drawn from a simulation): in the report and the figures");
+  cmd->add_option("--true-mu-r", args->true_mu_r, "likewise its rolling friction");
   cmd->add_option("--placed-jitter", args->placed_jitter,
                   "--deposit experiment: each replica's grains moved from the experiment's by a "
                   "normal draw of this RMS a coordinate (a length); auto: 1e-4 grain "
@@ -168,6 +179,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.preparation = preparation_named(args->preparation);
     o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
     o.fit_only = args->fit_only;
+    if (!args->true_mu_s.empty()) o.true_mu_s = one_friction(args->true_mu_s, "--true-mu-s");
+    if (!args->true_mu_r.empty()) o.true_mu_r = one_friction(args->true_mu_r, "--true-mu-r");
     o.parallel = args->threads;
     o.log = [](const std::string& line) { std::cerr << line << "\n"; };
     o.deposit_progress = print_deposit_progress(std::cerr);

@@ -45,7 +45,7 @@ step "3/5 tracking the scans (locate, link) and analysing the tracks"
 
 step "4/5 calibrating the DEM's friction on the tracked scans"
 "$granmem" --config $config calibrate --experiment "$out/tracks.h5" --out "$out/calibration" \
-  | tee "$out/calibration.txt"
+  --true-mu-s $TRUE_MU_S | tee "$out/calibration.txt"
 
 step "5/5 result"
 summary="$out/calibration/summary.json"

@@ -152,6 +152,19 @@ double true_friction(const RunHeader& experiment, const std::string& key) {
   }
 }
 
+// The friction a pseudo-experiment was made with: the one given (scans drawn from a
+// simulation do not carry it), which must agree with what the store says where it says one.
+double true_friction(const RunHeader& experiment, const std::string& key,
+                     std::optional<double> given) {
+  const double stored = true_friction(experiment, key);
+  if (!given) return stored;
+  if (std::isfinite(stored) && std::abs(*given - stored) > 1e-9 * stored) {
+    throw Error("--true-" + key + " " + number_text(*given) + ": the experiment's store says " +
+                number_text(stored));
+  }
+  return *given;
+}
+
 // The hole-axis error the twin's axes are given: the one asked for, else (auto) the
 // experiment's own, its scans' RMS axis standard error where its store has them (none for
 // a simulated experiment, whose axes are exact).
@@ -1274,6 +1287,11 @@ void CalibrateOptions::validate() const {
   check_frictions(mu_s, "--mu-s");
   if (joint()) check_frictions(mu_r, "--mu-r");
   const bool steady = observables == CalibrationObservables::steady_state;
+  for (const auto& [truth, option] :
+       {std::pair{true_mu_s, "--true-mu-s"}, {true_mu_r, "--true-mu-r"}}) {
+    if (truth && !(*truth > 0 && std::isfinite(*truth)))
+      throw Error(std::string(option) + ": a friction above 0");
+  }
   if (fit_only && !steady) {
     throw Error(
         "--fit-only: only with --observables steady-state (the displacement fit "
@@ -1339,8 +1357,8 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   options.validate();
   Twin twin(options, experiment);  // every setting checked before any output
   CalibrateSummary s;
-  s.true_mu_s = true_friction(experiment.header(), "mu-s");
-  s.true_mu_r = true_friction(experiment.header(), "mu-r");
+  s.true_mu_s = true_friction(experiment.header(), "mu-s", options.true_mu_s);
+  s.true_mu_r = true_friction(experiment.header(), "mu-r", options.true_mu_r);
   const bool steady = options.observables == CalibrationObservables::steady_state;
   if (steady) check_only(options, twin.measured_steady_state());
   std::string noise_model;

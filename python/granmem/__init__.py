@@ -316,11 +316,15 @@ def _frictions(value):
     return ",".join(repr(float(m)) for m in value)
 
 
+def _optional_float(value):
+    return None if value is None else float(value)
+
+
 def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="displacements", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
               refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
-              parallel=0, progress=None, **twin):
+              true_mu_s=None, true_mu_r=None, parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -355,7 +359,9 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     gets dicts with a ``line`` (and a run's ``cycle``, ``cycles``, ...). Ctrl-C stops
     after the runs under way and is raised. Returns a dict: mu_s, mu_s_ci95 (and mu_r,
     mu_r_ci95, correlation for a joint fit), true_mu_s / true_mu_r (a pseudo-experiment's,
-    else NaN), simulations, notes, written, report (the command line's lines)."""
+    else NaN; ``true_mu_s``, ``true_mu_r``: a pseudo-experiment's whose store does not say
+    them, scans drawn from a simulation, for the report and the figures), simulations,
+    notes, written, report (the command line's lines)."""
     only = [only] if isinstance(only, str) else list(only)
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),
                               _frictions(mu_r), observables, only, _range(window), str(noise),
@@ -365,5 +371,5 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
-                              bool(fit_only),
-                              int(parallel), twin, progress)
+                              bool(fit_only), _optional_float(true_mu_s),
+                              _optional_float(true_mu_r), int(parallel), twin, progress)

@@ -148,7 +148,9 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     tracks.to_csv(tmp_path / "scans.csv", index=False)
     cli("import", "scans.csv", "--out", "scans.h5", "--voxel-size", "0.1mm",
         "--container", ",".join(str(v / voxel) for v in (*lo, *hi)))
-    fit = granmem.calibrate(tmp_path / "scans.h5", tmp_path / "cal", **FIT, **TWIN)
+    fit = granmem.calibrate(tmp_path / "scans.h5", tmp_path / "cal", true_mu_s=0.2, **FIT,
+                            **TWIN)
+    assert fit["true_mu_s"] == 0.2  # given: scans drawn from a simulation do not carry it
     summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
     contacts = summary["locating_error_from_contacts"]
     assert 130 < contacts["across_um"] < 300 and 130 < contacts["along_z_um"] < 300

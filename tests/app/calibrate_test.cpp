@@ -46,13 +46,6 @@ double json_value(const std::string& json, const std::string& key) {
   return std::strtod(json.c_str() + at + key.size() + 3, nullptr);
 }
 
-std::string read_text(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 // summary.json's mu_s lies inside its interval and the simulated range 0.05-0.4; returns
 // the interval.
 std::array<double, 2> expect_fit_in_its_interval(const std::string& json) {
@@ -160,6 +153,13 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--axis-noise", "-1"}),
                        {"--axis-noise", ">= 0"});
+  // The truth given for a pseudo-experiment whose store says another.
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
+                                  "--true-mu-s", "0.3"}),
+                       {"--true-mu-s 0.3", "the experiment's store says 0.2"});
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
+                                  "--true-mu-s", "0.1,0.2"}),
+                       {"--true-mu-s", "one friction"});
 }
 
 // A twin that stops short of the experiment's friction holds the fit at its edge: said, with
@@ -302,7 +302,9 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   // Either way the design is placed and its count said (a 60-grain twin fits well inside).
   const bool refined = own.out.find("4 packing(s) more at mu_s ") != std::string::npos;
   EXPECT_TRUE(refined || own.out.find("not refined") != std::string::npos) << own.out;
-  if (refined) EXPECT_NE(own.out.find(", seeds 3-6"), std::string::npos) << own.out;
+  if (refined) {
+    EXPECT_NE(own.out.find(", seeds 3-6"), std::string::npos) << own.out;
+  }
   const std::string staged_json = read_text(in_work("staged/summary.json"));
   EXPECT_EQ(json_value(staged_json, "n_simulations"), refined ? 12 : 8) << own.out;
   EXPECT_EQ(json_value(staged_json, "refined"), refined ? 4 : 0) << staged_json;

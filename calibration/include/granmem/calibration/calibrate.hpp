@@ -93,7 +93,11 @@ struct CalibrateOptions {
   // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
   std::optional<int> refine;
   int refined_packings() const { return refine.value_or(0); }
-  int parallel = 0;  // runs at once, one thread each; 0: all cores
+  // The frictions a pseudo-experiment was made with, for the report and the figures, where
+  // its store does not say them (scans drawn from a simulation); a simulation's own are
+  // read from its store (given as well, they must agree).
+  std::optional<double> true_mu_s, true_mu_r;
+  int parallel = 0;  // runs at once; 0: one per core (a run alone takes every core)
   // Lines saying what the calibration does (the twin, reused runs and packings), the
   // deposition's progress, and each run's progress.
   std::function<void(const std::string&)> log;

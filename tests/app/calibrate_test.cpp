@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -377,6 +379,43 @@ TEST_F(Calibrate, FitsMuSAndMuRJointly) {
   EXPECT_NE(refined.out.find("2 packing(s) more at mu_s "), std::string::npos) << refined.out;
   EXPECT_NE(refined.out.find(", seeds 2-3"), std::string::npos) << refined.out;
   EXPECT_NE(refined.out.find("11 simulations"), std::string::npos) << refined.out;
+  // Started from the experiment's own packing: every run placed (2 replicas, each its
+  // jitter), and the truth, one of the design's points, inside both intervals.
+  std::vector<std::string> placed_fit{"calibrate",
+                                      "--experiment",
+                                      "exp.h5",
+                                      "--out",
+                                      "placed",
+                                      "--window",
+                                      "2:3",
+                                      "--mu-s",
+                                      "0.05,0.2,0.4",
+                                      "--mu-r",
+                                      "0.005,0.01,0.02",
+                                      "--fit",
+                                      "mu_s,mu_r",
+                                      "--observables",
+                                      "steady-state",
+                                      "--replicas",
+                                      "2",
+                                      "--fit-only",
+                                      "--deposit",
+                                      "experiment"};
+  placed_fit.insert(placed_fit.end(), kTwin.begin(), kTwin.end());
+  granmem_ok(placed_fit);
+  const std::string placed = read_text(in_work("placed/summary.json"));
+  EXPECT_NE(placed.find("\"deposit\": \"experiment\""), std::string::npos) << placed;
+  EXPECT_EQ(json_value(placed, "n_simulations"), 18) << placed;
+  const auto interval_holds = [&](const char* key, double truth) {
+    const std::size_t at = placed.find(std::string("\"") + key + "\": [");
+    ASSERT_NE(at, std::string::npos) << key;
+    double lo = 0, hi = 0;
+    std::sscanf(placed.c_str() + at + std::strlen(key) + 5, "%lf, %lf", &lo, &hi);
+    EXPECT_LE(lo, truth) << key << " in " << placed;
+    EXPECT_GE(hi, truth) << key << " in " << placed;
+  };
+  interval_holds("mu_s_ci95", 0.2);
+  interval_holds("mu_r_ci95", 0.01);
 }
 
 TEST_F(Calibrate, CompareTwoRuns) {

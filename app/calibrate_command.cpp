@@ -136,7 +136,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_flag("--fit-only", args->fit_only,
                 "steady-state: fit and stop; no run at the fitted friction, so no distances "
                 "or comparison figures (one simulation fewer)");
-  cmd->add_option("--threads", args->threads, "runs at once (default: all cores)");
+  cmd->add_option("--threads", args->threads,
+                  "runs at once, and the cores they use (default: one per core; the last run also "
+                  "takes the cores the others leave)");
   // The twin's settings: as `simulate` takes them, here or in the config's [simulate].
   std::map<std::string, CLI::Option*> given;
   const RunSettings defaults = default_simulate_settings();

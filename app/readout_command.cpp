@@ -41,7 +41,9 @@ void add_readout(CLI::App& app) {
   cmd->add_option("--training-amplitude", args->training_amplitude,
                   "add each state's training amplitude to its sweep")
       ->capture_default_str();
-  cmd->add_option("--parallel", args->parallel, "runs at once, one thread each (0: all cores)")
+  cmd->add_option("--parallel", args->parallel,
+                  "runs at once, and the cores they use (0: one per core; the last run also takes "
+                  "the cores the others leave)")
       ->capture_default_str();
   cmd->add_option("--bootstrap", args->bootstrap, "resamples of the grains for the errors")
       ->capture_default_str();

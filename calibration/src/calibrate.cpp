@@ -765,14 +765,18 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
 // experiment's positions are exact), against a poured twin (one placed from the scans
 // starts from their errors); NaN errors elsewhere. In metres.
 ContactLocatingError contacts_locating_error(const Twin& twin,
-                                             const std::vector<SteadyStateRun>& runs, double mu_s) {
+                                             const std::vector<SteadyStateRun>& runs, double mu_s,
+                                             double mu_r) {
   const KnownGrains known = twin.known_grains();
   if (!twin.experiment().header().voxel_size || !known.radius || runs.empty() ||
       twin.options().preparation == TwinPreparation::experiment)
     return {};
-  const auto nearest = std::min_element(runs.begin(), runs.end(), [&](auto& a, auto& b) {
-    return std::abs(std::log(a.mu_s / mu_s)) < std::abs(std::log(b.mu_s / mu_s));
-  });
+  const auto distance = [&](const SteadyStateRun& r) {  // in ln mu_s (and ln mu_r, joint)
+    return std::abs(std::log(r.mu_s / mu_s)) +
+           (std::isfinite(mu_r) && r.mu_r > 0 ? std::abs(std::log(r.mu_r / mu_r)) : 0.0);
+  };
+  const auto nearest = std::min_element(
+      runs.begin(), runs.end(), [&](auto& a, auto& b) { return distance(a) < distance(b); });
   const FrictionRunSpec spec{nearest->mu_s, nearest->seed, nearest->mu_r};
   return locating_error_from_contacts(twin.experiment(), TrajectoryReader(twin.path(spec)),
                                       2 * *known.radius);
@@ -811,12 +815,23 @@ struct ScanNoise {
   ContactLocatingError contacts;
 };
 
+bool read_from_contacts(const ContactLocatingError& e) {
+  return std::isfinite(e.across) && std::isfinite(e.along_z);
+}
+
+double fitted_mu_r(const ObservableFit&) {
+  return std::nan("");
+}
+double fitted_mu_r(const JointObservableFit& f) {
+  return f.mu_r;
+}
+
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
                                         const std::vector<double>& scatter,
                                         const ContactLocatingError& contacts) {
   Eigen::Vector3d e = twin.errors.position;
   double share = kNoiseShare;
-  if (std::isfinite(contacts.across) && std::isfinite(contacts.along_z)) {
+  if (read_from_contacts(contacts)) {
     e = Eigen::Vector3d(contacts.across, contacts.across, contacts.along_z) /
         metres_per_length(twin.experiment());
     share = kContactsNoiseShare;
@@ -854,7 +869,7 @@ template <class Fit, class Refit>
 Fit without_noise_limited(const Twin& twin, const std::vector<SteadyStateRun>& runs, Fit fit,
                           Refit refit, std::size_t fewest, ScanNoise* noise) {
   ScanNoise found;
-  found.contacts = contacts_locating_error(twin, runs, fit.mu_s);
+  found.contacts = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
   if (twin.options().only.empty())
     found.limited = noise_limited(twin, fit.names, fit.scatter, found.contacts);
   std::vector<std::string> kept;
@@ -893,7 +908,7 @@ JointObservableFit joint_steady_state_fit(const Twin& twin, const std::vector<St
 // The report's lines on the observables left out, and why; their names for summary.json.
 void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObject& j) {
   std::vector<std::string> names;
-  const bool contacts = std::isfinite(noise.contacts.across);
+  const bool contacts = read_from_contacts(noise.contacts);
   for (const NoiseLimited& l : noise.limited) {
     const bool rotation = l.name == "rot_disp";
     report << std::setprecision(3) << "  note: " << l.name
@@ -913,7 +928,7 @@ void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObje
 // The scans' locating error read from their contacts, said beside locate's standard errors.
 void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::ostream& report,
                           JsonObject& j) {
-  if (!std::isfinite(e.across)) return;
+  if (!read_from_contacts(e)) return;
   const double um = 1e6, stored = metres_per_length(twin.experiment()) * um;
   report << std::setprecision(3) << "  the scans' centres err by " << e.across * um
          << " um across the slices and " << e.along_z * um
@@ -1292,6 +1307,9 @@ void CalibrateOptions::validate() const {
     if (truth && !(*truth > 0 && std::isfinite(*truth)))
       throw Error(std::string(option) + ": a friction above 0");
   }
+  if (true_mu_s && !steady)
+    throw Error("--true-mu-s: only with --observables steady-state (its report and figures)");
+  if (true_mu_r && !joint()) throw Error("--true-mu-r: only with --fit mu_s,mu_r");
   if (fit_only && !steady) {
     throw Error(
         "--fit-only: only with --observables steady-state (the displacement fit "

@@ -62,7 +62,10 @@ std::vector<std::filesystem::path> run_friction_series(
   for (const FrictionRunSpec& r : runs)
     out.push_back(friction_run_path(options.dir, r));
   std::mutex report;
-  run_pool(runs.size(), {options.parallel, options.stop}, [&](std::size_t k, int cores) {
+  RunPoolOptions pool;
+  pool.parallel = options.parallel;
+  pool.stop = options.stop;
+  run_pool(runs.size(), pool, [&](std::size_t k, int cores) {
     Simulation sim = start(runs[k], cores);
     sim.set_threads(Simulation::threads_on_own_cores(sim.grains().size(), cores));
     CyclicOptions c = options.protocol;

@@ -20,32 +20,41 @@ RunPoolSummary run_pool(std::size_t count, const RunPoolOptions& options,
   for (std::size_t k = std::size_t(ranks.rank); k < count; k += std::size_t(ranks.size))
     mine.push_back(k);
   const int cores =
-      std::max(1, int(std::thread::hardware_concurrency()) / std::max(1, ranks.on_node));
+      options.cores > 0
+          ? options.cores
+          : std::max(1, int(std::thread::hardware_concurrency()) / std::max(1, ranks.on_node));
   const int workers = int(std::min<std::size_t>(
       mine.size(), std::size_t(options.parallel > 0 ? options.parallel : cores)));
-  const int share = std::max(1, cores / std::max(1, workers));
-  std::atomic<std::size_t> next{0}, done{0};
+  // A pool asked for fewer runs at once than the machine has cores uses no more cores.
+  const int pool_cores = options.parallel > 0 ? std::min(options.parallel, cores) : cores;
+  const int share = std::max(1, pool_cores / std::max(1, workers));
+  std::size_t next = 0;
+  std::atomic<std::size_t> done{0};
   std::mutex failed, dealing;
   std::exception_ptr failure;
   int cores_in_use = 0;
-  // The last runs dealt take the cores of the workers left with nothing to do.
-  auto deal = [&](std::size_t t) {
+  // The next run and its cores: the last run dealt also takes the cores no run holds (the
+  // last of a series, or a single run, need not leave cores unused); no run is dealt after
+  // it, so none is left short.
+  auto deal = [&](std::size_t& t, int& run_cores) {
     const std::lock_guard<std::mutex> lock(dealing);
-    const bool tail = mine.size() - t < std::size_t(workers);
-    const int run_cores = tail ? std::max(share, cores - cores_in_use) : share;
+    if (next >= mine.size()) return false;
+    t = next++;
+    run_cores = next == mine.size() ? std::max(share, pool_cores - cores_in_use) : share;
     cores_in_use += run_cores;
-    return run_cores;
+    return true;
   };
   auto stopped = [&] { return options.stop && options.stop->load(); };
   auto work = [&] {
-    for (std::size_t t; !stopped() && (t = next++) < mine.size();) {
-      const int run_cores = deal(t);
+    std::size_t t = 0;
+    for (int run_cores = 0; !stopped() && deal(t, run_cores);) {
       try {
         run(mine[t], run_cores);
         ++done;
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failed);
         if (!failure) failure = std::current_exception();
+        const std::lock_guard<std::mutex> no_more(dealing);
         next = mine.size();
       }
       const std::lock_guard<std::mutex> lock(dealing);

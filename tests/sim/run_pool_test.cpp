@@ -36,22 +36,33 @@ TEST(RunPool, RunsEveryRunOnceAndNoMoreAtOnceThanAsked) {
   }
 }
 
-// The cores given to the runs under way never add up to more than the machine's (or one
-// each, where more runs are asked at once than it has); a run alone gets them all.
+// The cores given to the runs under way never add up to more than the pool's (the
+// machine's, or as many as runs at once where fewer); a run alone gets them all, and the
+// last run dealt those the others leave.
 TEST(RunPool, TheRunsUnderWayShareTheCoresAndARunAloneGetsThemAll) {
   const int machine = std::max(1, int(std::thread::hardware_concurrency()));
   run_pool(1, {}, [&](std::size_t, int cores) { EXPECT_EQ(cores, machine); });
-  for (int parallel : {1, 2, 3}) {
-    std::atomic<int> in_use{0}, most{0};
-    run_pool(9, {parallel}, [&](std::size_t k, int cores) {
-      EXPECT_GE(cores, 1);
-      const int now = in_use += cores;
-      for (int m = most; now > m && !most.compare_exchange_weak(m, now);) {
+  run_pool(1, {1}, [&](std::size_t, int cores) { EXPECT_EQ(cores, 1); });
+  for (int cores : {2, 16}) {
+    for (int parallel : {0, 1, 3, 4}) {
+      for (std::size_t count : {1, 2, 3, 4, 9}) {
+        const int pool = parallel > 0 ? std::min(parallel, cores) : cores;
+        std::atomic<int> in_use{0}, most{0};
+        run_pool(count, {parallel, cores}, [&](std::size_t k, int given) {
+          EXPECT_GE(given, 1);
+          const int now = in_use += given;
+          for (int m = most; now > m && !most.compare_exchange_weak(m, now);) {
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(2 + 3 * int(k % 3)));
+          in_use -= given;
+        });
+        EXPECT_LE(most, std::max(pool, std::min(int(count), parallel > 0 ? parallel : cores)))
+            << count << " runs, " << parallel << " at once, " << cores << " cores";
+        if (count == 1) {
+          EXPECT_EQ(most, pool);
+        }
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(2 + 3 * int(k % 3)));
-      in_use -= cores;
-    });
-    EXPECT_LE(most, std::max(machine, parallel)) << parallel << " at once";
+    }
   }
 }
 

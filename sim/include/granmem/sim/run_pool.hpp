@@ -6,12 +6,13 @@
 
 namespace granmem {
 
-// Many independent runs side by side, one thread each: the amplitudes of a memory
+// Many independent runs side by side, each on cores of its own: the amplitudes of a memory
 // read-out, the frictions and packings of a calibration's simulated twin. A run is a
 // whole simulation, so the runs, not the grains, are what is shared out.
 struct RunPoolOptions {
   int parallel = 0;  // runs at once in this process; 0: one per core (shared by the ranks
                      // of an MPI job on the same machine)
+  int cores = 0;     // the cores the pool may use; 0: the machine's (shared likewise)
   // Set (Python's KeyboardInterrupt): no further run is started, those under way finish,
   // and run_pool throws an Error saying how many were done.
   const std::atomic<bool>* stop = nullptr;
@@ -24,8 +25,8 @@ struct RunPoolSummary {
 };
 
 // Calls run(k, cores) for every k in [0, count), `parallel` at a time, each on a thread of
-// its own; `cores`: those the run may use, the machine's shared among the workers, and a
-// run dealt when fewer are left than workers also those of the workers already idle (the
+// its own; `cores`: those the run may use, the pool's (the machine's, or `parallel` where
+// fewer) shared among the workers, and the last run dealt also those no run holds (the
 // last of a series, or a single run, need not leave cores unused). Runs are dealt in the
 // order of k as workers free up. The first exception thrown by a run stops the dealing; the runs
 // under way are finished, and the exception is rethrown.

@@ -162,6 +162,11 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--true-mu-s", "0.1,0.2"}),
                        {"--true-mu-s", "one friction"});
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--true-mu-s", "0.2"}),
+                       {"--true-mu-s", "steady-state"});
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
+                                  "--true-mu-r", "0.01"}),
+                       {"--true-mu-r", "--fit mu_s,mu_r"});
 }
 
 // A twin that stops short of the experiment's friction holds the fit at its edge: said, with

@@ -36,7 +36,6 @@ int main(int argc, char** argv) {
   if (!ok || replicas < 2) return 2;
   const PhysicsOptions physics = physics_from(v);
   DepositOptions deposit = deposit_from(v);
-  deposit.threads = 0;  // by the grains
   if (!std::isfinite(jitter)) jitter = 1e-4 * 2 * deposit.radius;
   const Grains placed = grains_of_frame(TrajectoryReader(argv[1]), 0, deposit, physics);
   double sum = 0, sum2 = 0, lid = 0, lid2 = 0;

@@ -1,5 +1,7 @@
 #include "granmem/sim/pair_lanes.hpp"
 
+#include "granmem/core/inline.hpp"
+
 namespace granmem {
 namespace {
 
@@ -27,16 +29,6 @@ GRANMEM_INLINE void evaluate_lanes(const ContactModel& model, PairLanes& L, doub
 }
 
 }  // namespace
-
-// x86-64-v4 (AVX-512), v3 (AVX2) and the baseline, picked when the program loads (an
-// ifunc): GCC 12 or later on Linux. Elsewhere, and in a native build, one version.
-#if defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) && \
-    __GNUC__ >= 12 && !defined(GRANMEM_NATIVE_BUILD)
-#define GRANMEM_LANE_TARGETS \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define GRANMEM_LANE_TARGETS
-#endif
 
 GRANMEM_LANE_TARGETS void evaluate_pair_lanes(const ContactModel& model, PairLanes& lanes,
                                               double dt) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -135,6 +136,64 @@ TEST(HoledSphere, OneBlurIsTheIsotropicModel) {
     EXPECT_NEAR(f.d_blur, (wider.value(p) - narrower.value(p)) / 2e-6, 5e-6) << p.transpose();
     EXPECT_EQ(f.d_blur_z, 0.0);
   }
+}
+
+// The lanes are the model fits' evaluation, fraction() the neighbours' and the tests': both
+// must be the same numbers, lane for lane, whatever vector width the machine runs (a grain
+// with its hole and without, one blur and two, the centre itself, more points than lanes).
+TEST(HoledSphere, LanesAreTheOnePointFractions) {
+  HoledSphere holed = anisotropic_grain(), solid = holed, one_blur = holed;
+  solid.hole = 0;
+  one_blur.blur_z = 0;
+  for (const HoledSphere& g : {holed, solid, one_blur}) {
+    std::vector<Eigen::Vector3d> points = rim_points(g);
+    points.push_back(g.centre);
+    points.push_back(g.centre + 40 * g.axis);  // far outside: 0
+    while (points.size() <= HoledSphere::Lanes::kCapacity)
+      points.push_back(points[points.size() % 37] + Eigen::Vector3d(0.31, -0.17, 0.05));
+    for (bool derivatives : {true, false}) {
+      for (std::size_t first = 0; first < points.size(); first += HoledSphere::Lanes::kCapacity) {
+        HoledSphere::Lanes lanes;
+        const int count =
+            int(std::min<std::size_t>(HoledSphere::Lanes::kCapacity, points.size() - first));
+        for (int l = 0; l < count; ++l)
+          for (int a = 0; a < 3; ++a)
+            lanes.point[a][l] = points[first + std::size_t(l)][a];
+        g.fractions(lanes, count, derivatives);
+        for (int l = 0; l < count; ++l) {
+          const Eigen::Vector3d& p = points[first + std::size_t(l)];
+          const HoledSphere::Fraction f = g.fraction(p, true);
+          ASSERT_TRUE(std::isfinite(f.value)) << p.transpose();
+          EXPECT_EQ(lanes.value[l], f.value) << p.transpose();
+          if (!derivatives) continue;
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_EQ(lanes.d_centre[a][l], f.d_centre[a]) << p.transpose();
+            EXPECT_EQ(lanes.d_axis[a][l], f.d_axis[a]) << p.transpose();
+          }
+          EXPECT_EQ(lanes.d_radius[l], f.d_radius) << p.transpose();
+          EXPECT_EQ(lanes.d_blur[l], f.d_blur) << p.transpose();
+          EXPECT_EQ(lanes.d_blur_z[l], f.d_blur_z) << p.transpose();
+        }
+      }
+    }
+  }
+}
+
+// The model's exponential: e^x to a few units in the last place where a double holds it,
+// 0 to within 1e-304 where it underflows, and not a number for not a number.
+TEST(HoledSphere, LanesExponentialIsExp) {
+  double worst = 0;
+  for (double x = -745; x <= 709; x += 0.01731) {
+    const double e = exp_in_lanes(x), expected = std::exp(x);
+    if (x >= -700) {
+      worst = std::max(worst, std::abs(e - expected) / expected);
+    } else {
+      EXPECT_LE(e, 1e-304) << x;
+    }
+  }
+  EXPECT_LT(worst, 1e-15);
+  EXPECT_EQ(exp_in_lanes(0), 1.0);
+  EXPECT_TRUE(std::isnan(exp_in_lanes(std::nan(""))));
 }
 
 }  // namespace

@@ -125,15 +125,18 @@ void subtract_found(Volume& vol, const Stack& stack, const Eigen::Array3i& bin,
     const Eigen::Vector3d lo = (c - reach).array().ceil().max(0.0);
     const Eigen::Vector3d hi = (c + reach).array().floor().min(
         Eigen::Array3d(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1)));
+    const auto subtract = [per_bin](float* binned, double m) { *binned -= float(per_bin * m); };
+    FractionsInTurn<float*, decltype(subtract)> in_turn(g, subtract);
     for (auto Z = std::int64_t(lo.z()); Z <= std::int64_t(hi.z()); ++Z) {
       for (auto Y = std::int64_t(lo.y()); Y <= std::int64_t(hi.y()); ++Y) {
         for (auto X = std::int64_t(lo.x()); X <= std::int64_t(hi.x()); ++X) {
           const Eigen::Vector3d p =
               Eigen::Vector3d(double(X), double(Y), double(Z)).cwiseProduct(voxel_size);
-          vol.at(X / bin[0], Y / bin[1], Z / bin[2]) -= float(per_bin * g.value(p));
+          in_turn.add(p, &vol.at(X / bin[0], Y / bin[1], Z / bin[2]));
         }
       }
     }
+    in_turn.finish();
   }
 }
 

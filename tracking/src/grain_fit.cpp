@@ -1,6 +1,8 @@
 #include "granmem/tracking/grain_fit.hpp"
 
 #include <ceres/tiny_solver.h>
+
+#include <algorithm>
 #include <cmath>
 
 #include "fit_covariance.hpp"
@@ -52,27 +54,36 @@ struct GrainResiduals {
       da1 = (e1 - s.axis * s.axis.dot(e1)) / len;
       da2 = (e2 - s.axis * s.axis.dot(e2)) / len;
     }
-    for (int k = 0; k < n; ++k) {
-      const HoledSphere::Fraction m = s.fraction(window->points[std::size_t(k)], jacobian);
-      const double keep = clear ? window->clear[std::size_t(k)] : 1.0;
-      const double dark = 1 - (1 - m.value) * keep;  // grain, ours or a neighbour's
-      residuals[k] = b - (b - g) * dark - window->intensity[std::size_t(k)];
-      if (!jacobian) continue;
-      const double scale = -(b - g) * keep;  // d residual / d M
-      auto J = [&](int p) -> double& {
-        return jacobian[std::size_t(p) * std::size_t(n) + std::size_t(k)];
-      };
-      J(0) = scale * m.d_centre.x();
-      J(1) = scale * m.d_centre.y();
-      J(2) = scale * m.d_centre.z();
-      J(3) = scale * m.d_radius;
-      J(4) = scale * m.d_blur * s.blur;  // d/d log s
-      J(5) = 1 - dark;
-      J(6) = dark;
-      J(7) = scale * m.d_blur_z * s.blur_z;
-      if (kAxis) {
-        J(8) = scale * m.d_axis.dot(da1);
-        J(9) = scale * m.d_axis.dot(da2);
+    HoledSphere::Lanes lanes;
+    for (int first = 0; first < n; first += HoledSphere::Lanes::kCapacity) {
+      const int count = std::min(HoledSphere::Lanes::kCapacity, n - first);
+      for (int l = 0; l < count; ++l) {
+        const Eigen::Vector3d& p = window->points[std::size_t(first + l)];
+        for (int a = 0; a < 3; ++a)
+          lanes.point[a][l] = p[a];
+      }
+      s.fractions(lanes, count, jacobian != nullptr);
+      for (int l = 0; l < count; ++l) {
+        const auto k = std::size_t(first + l);
+        const double keep = clear ? window->clear[k] : 1.0;
+        const double dark = 1 - (1 - lanes.value[l]) * keep;  // grain, ours or a neighbour's
+        residuals[k] = b - (b - g) * dark - window->intensity[k];
+        if (!jacobian) continue;
+        const double scale = -(b - g) * keep;  // d residual / d M
+        auto J = [&](int p) -> double& { return jacobian[std::size_t(p) * std::size_t(n) + k]; };
+        J(0) = scale * lanes.d_centre[0][l];
+        J(1) = scale * lanes.d_centre[1][l];
+        J(2) = scale * lanes.d_centre[2][l];
+        J(3) = scale * lanes.d_radius[l];
+        J(4) = scale * lanes.d_blur[l] * s.blur;  // d/d log s
+        J(5) = 1 - dark;
+        J(6) = dark;
+        J(7) = scale * lanes.d_blur_z[l] * s.blur_z;
+        if (kAxis) {
+          const Eigen::Vector3d d_axis(lanes.d_axis[0][l], lanes.d_axis[1][l], lanes.d_axis[2][l]);
+          J(8) = scale * d_axis.dot(da1);
+          J(9) = scale * d_axis.dot(da2);
+        }
       }
     }
     return true;

@@ -53,13 +53,13 @@ const Rules& rules() {
 double annulus(double p1, double q2, double excess, double iso, double out_iso, double rh_iso,
                bool u_wider) {
   const Rules& q = rules();
+  const BlurredDisk outer(out_iso), hole(rh_iso);
   double f = 0;
   for (int g = 0; g < q.k; ++g) {
     const double e = excess * q.hermite.x[std::size_t(g)];
     const double x1 = u_wider ? p1 + e : p1, x2 = u_wider ? q2 : q2 + e;
     const double rr = std::sqrt(x1 * x1 + x2 * x2 + 1e-24) / iso;
-    f += q.hermite.w[std::size_t(g)] *
-         (blurred_disk(rr, out_iso).value - blurred_disk(rr, rh_iso).value);
+    f += q.hermite.w[std::size_t(g)] * (outer.at(rr).value - hole.at(rr).value);
   }
   return f;
 }
@@ -72,13 +72,14 @@ ceres::Jet<double, N> annulus(const ceres::Jet<double, N>& p1, const ceres::Jet<
                               const ceres::Jet<double, N>& out_iso,
                               const ceres::Jet<double, N>& rh_iso, bool u_wider) {
   const Rules& q = rules();
+  const BlurredDisk outer_disk(out_iso.a), hole_disk(rh_iso.a);
   double f = 0, d_p1 = 0, d_q2 = 0, d_excess = 0, d_iso = 0, d_out = 0, d_rh = 0;
   for (int g = 0; g < q.k; ++g) {
     const double node = q.hermite.x[std::size_t(g)], weight = q.hermite.w[std::size_t(g)];
     const double e = excess.a * node;
     const double x1 = u_wider ? p1.a + e : p1.a, x2 = u_wider ? q2.a : q2.a + e;
     const double r = std::sqrt(x1 * x1 + x2 * x2 + 1e-24), rr = r / iso.a;
-    const DiskFraction outer = blurred_disk(rr, out_iso.a), hole = blurred_disk(rr, rh_iso.a);
+    const DiskFraction outer = outer_disk.at(rr), hole = hole_disk.at(rr);
     f += weight * (outer.value - hole.value);
     const double d_rr = weight * (outer.d_x - hole.d_x) / (r * iso.a);  // times d r
     d_p1 += d_rr * x1;

@@ -59,13 +59,9 @@ struct Candidate {
 };
 
 // The voxels within the ellipsoid of semi-axes `reach` (x, y, z) around `centre` into
-// `window`, each with how much of it the neighbours leave clear, `clear_at(p, d)` (d: p's
-// distance from the centre); voxels left under 1e-3 clear are left out (they say nothing
-// of this grain); the clear shares kept only `with_clear`.
-template <class ClearAt>
-void fill_window(const Stack& stack, const Eigen::Vector3d& centre, const Eigen::Vector3d& reach,
-                 const Eigen::Vector3d& vs, bool with_clear, const ClearAt& clear_at,
-                 GrainWindow& window) {
+// `window`: their physical positions and fluid fractions.
+void collect_window(const Stack& stack, const Eigen::Vector3d& centre, const Eigen::Vector3d& reach,
+                    const Eigen::Vector3d& vs, GrainWindow& window) {
   const Eigen::Array3d last(double(stack.nx - 1), double(stack.ny - 1), double(stack.nz - 1));
   const Eigen::Vector3d lo = ((centre - reach).array() / vs.array()).ceil().max(0.0);
   const Eigen::Vector3d hi = ((centre + reach).array() / vs.array()).floor().min(last);
@@ -77,15 +73,38 @@ void fill_window(const Stack& stack, const Eigen::Vector3d& centre, const Eigen:
       for (auto x = std::int64_t(lo.x()); x <= std::int64_t(hi.x()); ++x) {
         const Eigen::Vector3d p = Eigen::Vector3d(double(x), double(y), double(z)).cwiseProduct(vs);
         if ((p - centre).cwiseQuotient(reach).squaredNorm() > 1) continue;
-        const double d = (p - centre).norm();
-        const double clear = clear_at(p, d);
-        if (clear < 1e-3) continue;
         window.points.push_back(p);
         window.intensity.push_back(fluid_fraction(stack.at(x, y, z)));
-        if (with_clear) window.clear.push_back(clear);
       }
     }
   }
+}
+
+// Leaves out of `window` the voxels the neighbours leave under 1e-3 clear (`clear`, one a
+// voxel): they say nothing of this grain. Keeps the clear shares only `with_clear`.
+void leave_out_hidden(const std::vector<double>& clear, bool with_clear, GrainWindow& window) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < clear.size(); ++k) {
+    if (clear[k] < 1e-3) continue;
+    window.points[kept] = window.points[k];
+    window.intensity[kept] = window.intensity[k];
+    if (with_clear) window.clear.push_back(clear[k]);
+    ++kept;
+  }
+  window.points.resize(kept);
+  window.intensity.resize(kept);
+}
+
+// `grain`'s fraction M at each voxel of `window` within `reach` of its centre, passed on
+// as combine(voxel, M), lanes of voxels at a time.
+template <class Combine>
+void grain_fraction_near(const HoledSphere& grain, double reach, const GrainWindow& window,
+                         const Combine& combine) {
+  FractionsInTurn<std::size_t, const Combine&> in_turn(grain, combine);
+  for (std::size_t k = 0; k < window.points.size(); ++k) {
+    if ((window.points[k] - grain.centre).norm() < reach) in_turn.add(window.points[k], k);
+  }
+  in_turn.finish();
 }
 
 // The voxels within `reach` (x, y, z) of grain `s`: with `model_neighbours`, each with how much of
@@ -94,30 +113,38 @@ void fill_window(const Stack& stack, const Eigen::Vector3d& centre, const Eigen:
 void window_of(const Stack& stack, const HoledSphere& s, const Eigen::Vector3d& reach,
                const std::vector<const HoledSphere*>& near, bool model_neighbours,
                const Eigen::Vector3d& vs, GrainWindow& window) {
-  const auto clear_at = [&](const Eigen::Vector3d& p, double d) {
-    double clear = 1;
+  collect_window(stack, s.centre, reach, vs, window);
+  std::vector<double> clear(window.points.size(), 1.0);
+  if (model_neighbours) {
     for (const HoledSphere* other : near) {
-      if (model_neighbours) {
-        if ((p - other->centre).norm() < other->radius + 4 * other->widest_blur()) {
-          clear *= 1 - other->value(p);
-        }
-      } else if ((p - other->centre).norm() < d) {
-        return 0.0;  // theirs
+      const double other_reach = other->radius + 4 * other->widest_blur();
+      // None of the window's voxels within its reach: not one to look at.
+      if (!((other->centre - s.centre).norm() < other_reach + reach.maxCoeff())) continue;
+      grain_fraction_near(*other, other_reach, window,
+                          [&](std::size_t k, double m) { clear[k] *= 1 - m; });
+    }
+  } else {
+    for (std::size_t k = 0; k < clear.size(); ++k) {
+      const double d = (window.points[k] - s.centre).norm();
+      for (const HoledSphere* other : near) {
+        if ((window.points[k] - other->centre).norm() < d) clear[k] = 0;  // theirs
       }
     }
-    return clear;
-  };
-  fill_window(stack, s.centre, reach, vs, model_neighbours, clear_at, window);
+  }
+  leave_out_hidden(clear, model_neighbours, window);
 }
 
 // The voxels within `reach` of `centre`, each with what the neighbours leave clear, 1 -
-// the sum of their grain fractions there (`others`).
-template <class Others>
+// the sum of their grain fractions there, which add_others(window, sum) adds to `sum`.
+template <class AddOthers>
 void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
-                  const Others& others, const Eigen::Vector3d& vs, GrainWindow& window) {
-  fill_window(
-      stack, centre, Eigen::Vector3d::Constant(reach), vs, true,
-      [&](const Eigen::Vector3d& p, double) { return 1 - others(p); }, window);
+                  const AddOthers& add_others, const Eigen::Vector3d& vs, GrainWindow& window) {
+  collect_window(stack, centre, Eigen::Vector3d::Constant(reach), vs, window);
+  std::vector<double> others(window.points.size(), 0.0);
+  add_others(window, others);
+  for (double& clear : others)
+    clear = 1 - clear;
+  leave_out_hidden(others, true, window);
 }
 
 }  // namespace
@@ -475,16 +502,19 @@ class GrainLocator {
           const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.widest_blur());
           if (j != k && (s.centre - f.sphere.centre).norm() < reach + reach_j) near.push_back(s);
         });
-        const auto others = [&](const Eigen::Vector3d& p) {
-          double sum = 0;
+        const auto others = [&](const GrainWindow& w, std::vector<double>& sum) {
           for (const HoledSphere& s : near) {
             if (!blur.sampled) {
-              if ((p - s.centre).norm() < s.radius + 4 * s.widest_blur()) sum += s.value(p);
-            } else if ((p - s.centre).norm() < s.radius + 5 * wide) {
-              sum += blurred_grain_fraction(p, s, blur.across, blur.along_z);
+              grain_fraction_near(s, s.radius + 4 * s.widest_blur(), w,
+                                  [&](std::size_t k, double m) { sum[k] += m; });
+              continue;
+            }
+            for (std::size_t k = 0; k < w.points.size(); ++k) {
+              const Eigen::Vector3d& p = w.points[k];
+              if ((p - s.centre).norm() < s.radius + 5 * wide)
+                sum[k] += blurred_grain_fraction(p, s, blur.across, blur.along_z);
             }
           }
-          return sum;
         };
         inner_window(stack_, f.sphere.centre, reach, others, vs_, window);
         refits[k] = fit_hole_axis(window, f, axis_options);

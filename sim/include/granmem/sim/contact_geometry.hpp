@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "granmem/sim/inline.hpp"
+#include "granmem/core/inline.hpp"
 
 namespace granmem {
 

@@ -4,7 +4,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
-#include "granmem/sim/inline.hpp"
+#include "granmem/core/inline.hpp"
 #include "granmem/sim/normal_force.hpp"
 #include "granmem/sim/rolling_friction.hpp"
 #include "granmem/sim/sliding_friction.hpp"

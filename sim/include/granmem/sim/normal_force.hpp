@@ -4,7 +4,7 @@
 
 #include "granmem/sim/contact_geometry.hpp"
 #include "granmem/sim/contact_parameters.hpp"
-#include "granmem/sim/inline.hpp"
+#include "granmem/core/inline.hpp"
 
 namespace granmem {
 

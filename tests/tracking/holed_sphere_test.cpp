@@ -157,14 +157,14 @@ TEST(HoledSphere, LanesAreTheOnePointFractions) {
         const int count =
             int(std::min<std::size_t>(HoledSphere::Lanes::kCapacity, points.size() - first));
         for (int l = 0; l < count; ++l)
-          for (int a = 0; a < 3; ++a)
-            lanes.point[a][l] = points[first + std::size_t(l)][a];
+          lanes.set_point(l, points[first + std::size_t(l)]);
         g.fractions(lanes, count, derivatives);
         for (int l = 0; l < count; ++l) {
           const Eigen::Vector3d& p = points[first + std::size_t(l)];
           const HoledSphere::Fraction f = g.fraction(p, true);
           ASSERT_TRUE(std::isfinite(f.value)) << p.transpose();
           EXPECT_EQ(lanes.value[l], f.value) << p.transpose();
+          EXPECT_EQ(lanes.value[l], g.value(p)) << p.transpose();  // the value-only path
           if (!derivatives) continue;
           for (int a = 0; a < 3; ++a) {
             EXPECT_EQ(lanes.d_centre[a][l], f.d_centre[a]) << p.transpose();

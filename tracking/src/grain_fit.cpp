@@ -57,11 +57,8 @@ struct GrainResiduals {
     HoledSphere::Lanes lanes;
     for (int first = 0; first < n; first += HoledSphere::Lanes::kCapacity) {
       const int count = std::min(HoledSphere::Lanes::kCapacity, n - first);
-      for (int l = 0; l < count; ++l) {
-        const Eigen::Vector3d& p = window->points[std::size_t(first + l)];
-        for (int a = 0; a < 3; ++a)
-          lanes.point[a][l] = p[a];
-      }
+      for (int l = 0; l < count; ++l)
+        lanes.set_point(l, window->points[std::size_t(first + l)]);
       s.fractions(lanes, count, jacobian != nullptr);
       for (int l = 0; l < count; ++l) {
         const auto k = std::size_t(first + l);

@@ -53,13 +53,13 @@ const Rules& rules() {
 double annulus(double p1, double q2, double excess, double iso, double out_iso, double rh_iso,
                bool u_wider) {
   const Rules& q = rules();
-  const BlurredDisk outer(out_iso), hole(rh_iso);
+  const BlurredDisk outer_disk(out_iso), hole_disk(rh_iso);
   double f = 0;
   for (int g = 0; g < q.k; ++g) {
     const double e = excess * q.hermite.x[std::size_t(g)];
     const double x1 = u_wider ? p1 + e : p1, x2 = u_wider ? q2 : q2 + e;
     const double rr = std::sqrt(x1 * x1 + x2 * x2 + 1e-24) / iso;
-    f += q.hermite.w[std::size_t(g)] * (outer.at(rr).value - hole.at(rr).value);
+    f += q.hermite.w[std::size_t(g)] * (outer_disk.at(rr).value - hole_disk.at(rr).value);
   }
   return f;
 }

@@ -1,5 +1,7 @@
 #include "granmem/tracking/holed_sphere.hpp"
 
+#include <cassert>
+
 #include "granmem/core/inline.hpp"
 
 namespace granmem {
@@ -28,72 +30,77 @@ GRANMEM_INLINE double dot(const Vec& a, const Vec& b) {
 }
 
 // M and its derivatives at one point, in plain numbers, for one lane as for one call (the
-// derivatives left out by the compiler where unused). With the point p - c = d, r = |d|, n
-// = d / r: u = (R - r) / s(n_z), dr/dc = -n, dn_z/dc = -(e_z - n_z n) / r; and for the hole,
-// w = (h R - rho) / s(m_z), drho/dc = -m, drho/da = -t m, dm_z/dc = -(e_z - a_z a - m_z m) /
-// rho, dm_z/da = -(a_z d + t (e_z - m_z m)) / rho. A point on the centre (or the axis) takes
-// the normal 0 there.
-struct Point {
+// derivatives left out by the compiler where unused). A point on the centre (or the axis)
+// takes the normal 0 there.
+struct FractionAndSlopes {
   double value;
   Vec d_centre;
   double d_radius, d_blur, d_blur_z;
   Vec d_axis;
 };
-template <bool kHole>
-GRANMEM_INLINE Point fraction_at(const HoledSphere& g, const Vec& p) {
-  const double bz = g.along_z();
-  const Vec d{p.x - g.centre.x(), p.y - g.centre.y(), p.z - g.centre.z()};
+
+// The sphere's S and its slopes. With p - c = d, r = |d|, n = d / r: u = (R - r) / s(n_z),
+// dr/dc = -n, dn_z/dc = -(e_z - n_z n) / r.
+GRANMEM_INLINE FractionAndSlopes sphere_term(const HoledSphere& g, const Vec& d) {
   const double r = std::sqrt(dot(d, d));
   const double inverse_r = r > 0 ? 1 / r : 0;
   const Vec n{d.x * inverse_r, d.y * inverse_r, d.z * inverse_r};
-  const SurfaceBlur sb(g.blur, bz, n.z);
+  const SurfaceBlur sb(g.blur, g.along_z(), n.z);
   const double u = (g.radius - r) / sb.s;
   const NormalCdfPdf su = normal_cdf_pdf(u);
-  const double sphere = su.cdf;
-
-  // dS, times (1 - H).
   const double ds = su.pdf / sb.s;
   const double bend = u * sb.ds_nz * inverse_r;  // n_z's part of du/dc
-  const Vec du_dc{n.x - bend * n.z * n.x, n.y - bend * n.z * n.y, n.z + bend * (1 - n.z * n.z)};
-  Point f;
+  FractionAndSlopes f;
+  f.value = su.cdf;
+  f.d_centre = {ds * (n.x - bend * n.z * n.x), ds * (n.y - bend * n.z * n.y),
+                ds * (n.z + bend * (1 - n.z * n.z))};
+  f.d_radius = ds;
+  f.d_blur = -ds * u * sb.ds_across;
+  f.d_blur_z = -ds * u * sb.ds_along_z;
   f.d_axis = {0, 0, 0};
-  if constexpr (!kHole) {
-    f.value = sphere;
-    f.d_centre = {ds * du_dc.x, ds * du_dc.y, ds * du_dc.z};
-    f.d_radius = ds;
-    f.d_blur = -ds * u * sb.ds_across;
-    f.d_blur_z = -ds * u * sb.ds_along_z;
-  } else {
-    const Vec a{g.axis.x(), g.axis.y(), g.axis.z()};
-    const double t = dot(d, a);
-    const Vec q{d.x - t * a.x, d.y - t * a.y, d.z - t * a.z};  // the part of d across the axis
-    const double rho = std::sqrt(dot(q, q));
-    const double inverse_rho = rho > 0 ? 1 / rho : 0;
-    const Vec m{q.x * inverse_rho, q.y * inverse_rho, q.z * inverse_rho};
-    const SurfaceBlur hb(g.blur, bz, m.z);
-    const double w = (g.hole * g.radius - rho) / hb.s;
-    const NormalCdfPdf hw = normal_cdf_pdf(w);
-    const double open = 1 - hw.cdf;
-    f.value = sphere * open;
-    f.d_centre = {ds * du_dc.x * open, ds * du_dc.y * open, ds * du_dc.z * open};
-    f.d_radius = ds * open;
-    f.d_blur = -ds * u * sb.ds_across * open;
-    f.d_blur_z = -ds * u * sb.ds_along_z * open;
+  return f;
+}
 
-    // dH, times S.
-    const double dh = sphere * hw.pdf / hb.s;
-    const double tilt = w * hb.ds_nz * inverse_rho;  // m_z's part of dw/dc and dw/da
-    const Vec ez_across{-a.z * a.x - m.z * m.x, -a.z * a.y - m.z * m.y, 1 - a.z * a.z - m.z * m.z};
-    f.d_centre.x -= dh * (m.x + tilt * ez_across.x);
-    f.d_centre.y -= dh * (m.y + tilt * ez_across.y);
-    f.d_centre.z -= dh * (m.z + tilt * ez_across.z);
-    f.d_radius -= dh * g.hole;
-    f.d_blur += dh * w * hb.ds_across;
-    f.d_blur_z += dh * w * hb.ds_along_z;
-    f.d_axis = {-dh * (t * m.x + tilt * (a.z * d.x - t * m.z * m.x)),
-                -dh * (t * m.y + tilt * (a.z * d.y - t * m.z * m.y)),
-                -dh * (t * m.z + tilt * (a.z * d.z + t * (1 - m.z * m.z)))};
-  }
+// S (1 - H) from the sphere's S: the hole's H taken out. With t = d.a, the part of d
+// across the axis q = d - t a, rho = |q|, m = q / rho: w = (h R - rho) / s(m_z), drho/dc =
+// -m, drho/da = -t m, dm_z/dc = -(e_z - a_z a - m_z m) / rho, dm_z/da = -(a_z d + t (e_z -
+// m_z m)) / rho.
+GRANMEM_INLINE void take_out_hole(const HoledSphere& g, const Vec& d, FractionAndSlopes& f) {
+  const Vec a{g.axis.x(), g.axis.y(), g.axis.z()};
+  const double t = dot(d, a);
+  const Vec q{d.x - t * a.x, d.y - t * a.y, d.z - t * a.z};
+  const double rho = std::sqrt(dot(q, q));
+  const double inverse_rho = rho > 0 ? 1 / rho : 0;
+  const Vec m{q.x * inverse_rho, q.y * inverse_rho, q.z * inverse_rho};
+  const SurfaceBlur hb(g.blur, g.along_z(), m.z);
+  const double w = (g.hole * g.radius - rho) / hb.s;
+  const NormalCdfPdf hw = normal_cdf_pdf(w);
+  const double sphere = f.value, open = 1 - hw.cdf;
+  // dS times (1 - H), less S times dH.
+  f.value = sphere * open;
+  f.d_centre = {f.d_centre.x * open, f.d_centre.y * open, f.d_centre.z * open};
+  f.d_radius *= open;
+  f.d_blur *= open;
+  f.d_blur_z *= open;
+  const double dh = sphere * hw.pdf / hb.s;
+  const double tilt = w * hb.ds_nz * inverse_rho;  // m_z's part of dw/dc and dw/da
+  const Vec ez_across{-a.z * a.x - m.z * m.x, -a.z * a.y - m.z * m.y, 1 - a.z * a.z - m.z * m.z};
+  f.d_centre.x -= dh * (m.x + tilt * ez_across.x);
+  f.d_centre.y -= dh * (m.y + tilt * ez_across.y);
+  f.d_centre.z -= dh * (m.z + tilt * ez_across.z);
+  f.d_radius -= dh * g.hole;
+  f.d_blur += dh * w * hb.ds_across;
+  f.d_blur_z += dh * w * hb.ds_along_z;
+  f.d_axis = {-dh * (t * m.x + tilt * (a.z * d.x - t * m.z * m.x)),
+              -dh * (t * m.y + tilt * (a.z * d.y - t * m.z * m.y)),
+              -dh * (t * m.z + tilt * (a.z * d.z + t * (1 - m.z * m.z)))};
+}
+
+template <bool kHole>
+GRANMEM_INLINE FractionAndSlopes fraction_at(const HoledSphere& g, const Vec& p) {
+  const Vec d{p.x - g.centre.x(), p.y - g.centre.y(), p.z - g.centre.z()};
+  FractionAndSlopes f = sphere_term(g, d);
+  if constexpr (kHole) take_out_hole(g, d, f);
   if (!(g.blur_z > 0)) {  // one blur, alike in every direction
     f.d_blur += f.d_blur_z;
     f.d_blur_z = 0;
@@ -106,7 +113,8 @@ template <bool kHole, bool kDerivatives>
 GRANMEM_INLINE void fill_lanes(const HoledSphere& g, HoledSphere::Lanes& L, int count) {
 #pragma omp simd
   for (int l = 0; l < count; ++l) {
-    const Point f = fraction_at<kHole>(g, {L.point[0][l], L.point[1][l], L.point[2][l]});
+    const FractionAndSlopes f =
+        fraction_at<kHole>(g, {L.point[0][l], L.point[1][l], L.point[2][l]});
     L.value[l] = f.value;
     if constexpr (kDerivatives) {
       L.d_centre[0][l] = f.d_centre.x;
@@ -131,7 +139,8 @@ HoledSphere::Fraction HoledSphere::fraction(const Eigen::Vector3d& p, bool deriv
     out.value = hole > 0 ? fraction_at<true>(*this, at).value : fraction_at<false>(*this, at).value;
     return out;
   }
-  const Point f = hole > 0 ? fraction_at<true>(*this, at) : fraction_at<false>(*this, at);
+  const FractionAndSlopes f =
+      hole > 0 ? fraction_at<true>(*this, at) : fraction_at<false>(*this, at);
   out.value = f.value;
   out.d_centre = {f.d_centre.x, f.d_centre.y, f.d_centre.z};
   out.d_radius = f.d_radius;
@@ -142,6 +151,7 @@ HoledSphere::Fraction HoledSphere::fraction(const Eigen::Vector3d& p, bool deriv
 }
 
 GRANMEM_LANE_TARGETS void HoledSphere::fractions(Lanes& lanes, int count, bool derivatives) const {
+  assert(count >= 0 && count <= Lanes::kCapacity);
   if (hole > 0) {
     derivatives ? fill_lanes<true, true>(*this, lanes, count)
                 : fill_lanes<true, false>(*this, lanes, count);

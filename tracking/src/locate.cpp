@@ -118,8 +118,10 @@ void window_of(const Stack& stack, const HoledSphere& s, const Eigen::Vector3d& 
   if (model_neighbours) {
     for (const HoledSphere* other : near) {
       const double other_reach = other->radius + 4 * other->widest_blur();
-      // None of the window's voxels within its reach: not one to look at.
-      if (!((other->centre - s.centre).norm() < other_reach + reach.maxCoeff())) continue;
+      // None of the window's voxels within its reach (with a margin for the roundings of
+      // the distances): not one to look at.
+      const double meets = (other_reach + reach.maxCoeff()) * (1 + 1e-9);
+      if (!((other->centre - s.centre).norm() < meets)) continue;
       grain_fraction_near(*other, other_reach, window,
                           [&](std::size_t k, double m) { clear[k] *= 1 - m; });
     }
@@ -127,7 +129,10 @@ void window_of(const Stack& stack, const HoledSphere& s, const Eigen::Vector3d& 
     for (std::size_t k = 0; k < clear.size(); ++k) {
       const double d = (window.points[k] - s.centre).norm();
       for (const HoledSphere* other : near) {
-        if ((window.points[k] - other->centre).norm() < d) clear[k] = 0;  // theirs
+        if ((window.points[k] - other->centre).norm() < d) {
+          clear[k] = 0;  // theirs
+          break;
+        }
       }
     }
   }
@@ -140,11 +145,11 @@ template <class AddOthers>
 void inner_window(const Stack& stack, const Eigen::Vector3d& centre, double reach,
                   const AddOthers& add_others, const Eigen::Vector3d& vs, GrainWindow& window) {
   collect_window(stack, centre, Eigen::Vector3d::Constant(reach), vs, window);
-  std::vector<double> others(window.points.size(), 0.0);
-  add_others(window, others);
-  for (double& clear : others)
-    clear = 1 - clear;
-  leave_out_hidden(others, true, window);
+  std::vector<double> clear(window.points.size(), 0.0);
+  add_others(window, clear);  // the neighbours' grain fractions, then what they leave clear
+  for (double& c : clear)
+    c = 1 - c;
+  leave_out_hidden(clear, true, window);
 }
 
 }  // namespace

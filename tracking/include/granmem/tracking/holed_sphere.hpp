@@ -3,10 +3,13 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <utility>
+
+#include "granmem/core/inline.hpp"
 
 namespace granmem {
 
@@ -58,6 +61,10 @@ struct HoledSphere {
     double value[kCapacity];
     double d_centre[3][kCapacity], d_radius[kCapacity], d_blur[kCapacity], d_blur_z[kCapacity];
     double d_axis[3][kCapacity];
+    void set_point(int lane, const Eigen::Vector3d& p) {
+      for (int a = 0; a < 3; ++a)
+        point[a][lane] = p[a];
+    }
   };
   // Fills the outputs of lanes 0 to count - 1 (the derivatives only with `derivatives`).
   void fractions(Lanes& lanes, int count, bool derivatives) const;
@@ -70,9 +77,9 @@ template <class Tag, class Use>
 class FractionsInTurn {
  public:
   FractionsInTurn(const HoledSphere& grain, Use use) : grain_(grain), use_(std::move(use)) {}
+  ~FractionsInTurn() { assert(count_ == 0 && "finish() hands on the last points"); }
   void add(const Eigen::Vector3d& p, Tag tag) {
-    for (int a = 0; a < 3; ++a)
-      lanes_.point[a][count_] = p[a];
+    lanes_.set_point(count_, p);
     tags_[std::size_t(count_++)] = tag;
     if (count_ == HoledSphere::Lanes::kCapacity) finish();
   }
@@ -94,7 +101,7 @@ class FractionsInTurn {
 // e^x without branches or calls, so that loops over it vectorise: x = k ln 2 + r, |r| <=
 // ln 2 / 2, e^r by its Taylor series to r^12 (relative error < 2e-16), 2^k from the bits;
 // x is held to [-700, 709] (e^-700 ~ 1e-304: nothing the callers tell from 0).
-inline double exp_in_lanes(double x) {
+GRANMEM_INLINE double exp_in_lanes(double x) {
   x = std::min(std::max(x, -700.0), 709.0);
   // Adding 1.5 2^52 rounds to an integer held in the low bits of the sum's mantissa.
   constexpr double kShifter = 6755399441055744.0, kLog2e = 1.4426950408889634;
@@ -102,10 +109,20 @@ inline double exp_in_lanes(double x) {
   const double shifted = x * kLog2e + kShifter;
   const double k = shifted - kShifter;
   const double r = (x - k * kLn2High) - k * kLn2Low;
-  double p = 1.0 / 479001600;  // 1 / 12!
-  for (double factorial :
-       {39916800.0, 3628800.0, 362880.0, 40320.0, 5040.0, 720.0, 120.0, 24.0, 6.0, 2.0, 1.0, 1.0})
-    p = p * r + 1 / factorial;
+  // Horner's scheme, written out: a loop here would keep the callers' loops from vectorising.
+  const double p =
+      1 +
+      r * (1 + r * (1.0 / 2 +
+                    r * (1.0 / 6 +
+                         r * (1.0 / 24 +
+                              r * (1.0 / 120 +
+                                   r * (1.0 / 720 +
+                                        r * (1.0 / 5040 +
+                                             r * (1.0 / 40320 +
+                                                  r * (1.0 / 362880 +
+                                                       r * (1.0 / 3628800 +
+                                                            r * (1.0 / 39916800 +
+                                                                 r * (1.0 / 479001600))))))))))));
   std::uint64_t bits, shifter_bits;
   std::memcpy(&bits, &shifted, sizeof bits);
   std::memcpy(&shifter_bits, &kShifter, sizeof bits);
@@ -121,7 +138,7 @@ inline double exp_in_lanes(double x) {
 struct NormalCdfPdf {
   double cdf, pdf;
 };
-inline NormalCdfPdf normal_cdf_pdf(double u) {
+GRANMEM_INLINE NormalCdfPdf normal_cdf_pdf(double u) {
   const double e = exp_in_lanes(-0.5 * u * u);
   const double t = 1 / (1 + 0.3275911 * M_SQRT1_2 * std::abs(u));
   const double lower_tail =  // Phi(-|u|) = erfc(|u| / sqrt 2) / 2

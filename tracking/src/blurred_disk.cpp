@@ -9,7 +9,7 @@
 namespace granmem {
 namespace {
 
-constexpr double kStep = BlurredDisk::kStep, kMaxY = BlurredDisk::kMaxY;
+constexpr double kStep = BlurredDisk::kStep;
 constexpr int kNy = BlurredDisk::kNy, kNx = BlurredDisk::kNx;
 
 // e^-z I0(z), the exponentially scaled modified Bessel function.

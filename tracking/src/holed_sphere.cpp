@@ -4,6 +4,11 @@
 
 #include "granmem/core/inline.hpp"
 
+#if defined(__clang__)
+// Under the sanitizers clang cannot vectorise the lanes, and says so at every build.
+#pragma clang diagnostic ignored "-Wpass-failed"
+#endif
+
 namespace granmem {
 namespace {
 

@@ -224,6 +224,16 @@ double blurred_grain_fraction(const Eigen::Vector3d& p, const HoledSphere& grain
   return model.value(p - grain.centre);
 }
 
+void add_blurred_grain_fraction(const std::vector<Eigen::Vector3d>& points, double reach,
+                                const HoledSphere& grain, double blur_across, double blur_along_z,
+                                std::vector<double>& sum) {
+  const BlurredGrain<double> model(grain.axis.normalized(), blur_across, blur_along_z, grain.radius,
+                                   grain.hole);
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if ((points[k] - grain.centre).norm() < reach) sum[k] += model.value(points[k] - grain.centre);
+  }
+}
+
 HoleAxisFit fit_hole_axis(const GrainWindow& inner, const GrainFit& grain,
                           const HoleAxisOptions& o) {
   HoleAxisFit fit;

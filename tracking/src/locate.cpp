@@ -514,11 +514,8 @@ class GrainLocator {
                                   [&](std::size_t k, double m) { sum[k] += m; });
               continue;
             }
-            for (std::size_t k = 0; k < w.points.size(); ++k) {
-              const Eigen::Vector3d& p = w.points[k];
-              if ((p - s.centre).norm() < s.radius + 5 * wide)
-                sum[k] += blurred_grain_fraction(p, s, blur.across, blur.along_z);
-            }
+            add_blurred_grain_fraction(w.points, s.radius + 5 * wide, s, blur.across, blur.along_z,
+                                       sum);
           }
         };
         inner_window(stack_, f.sphere.centre, reach, others, vs_, window);

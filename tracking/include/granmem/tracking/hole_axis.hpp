@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "granmem/tracking/grain_fit.hpp"
 #include "granmem/tracking/stack.hpp"
@@ -48,6 +49,11 @@ struct HoleAxisFit {
 // 1.0 / 1.0 / 1.5 voxel, 1.5x slices, and locate no faster).
 double blurred_grain_fraction(const Eigen::Vector3d& p, const HoledSphere& grain,
                               double blur_across, double blur_along_z);
+// The same at each of `points` nearer its centre than `reach`, added to `sum` (one a
+// point; the image's set-up, the grain's, made once).
+void add_blurred_grain_fraction(const std::vector<Eigen::Vector3d>& points, double reach,
+                                const HoledSphere& grain, double blur_across, double blur_along_z,
+                                std::vector<double>& sum);
 
 // The hole's axis refitted on the grain's inner voxels (within `within` x its radius of
 // the fitted centre; `inner` as GrainWindow, `clear` optional: 1 - the neighbours' summed

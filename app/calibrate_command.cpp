@@ -32,7 +32,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   struct Args {
     std::string experiment, out, mu_s, window, noise = "auto", wall_distance = "0",
                                                preparation = "auto", summaries = "pooled",
-                                               observables = "displacements", only, fit = "mu_s";
+                                               observables = "steady-state", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 0, refine = -1;
@@ -42,7 +42,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   auto args = std::make_shared<Args>();
   CLI::App* cmd = app.add_subcommand(
       "calibrate",
-      "Fit the DEM's sliding friction mu_s so that its end-of-cycle displacements match an "
+      "Fit the DEM's sliding friction mu_s (or mu_s and mu_r) so that a simulated twin's "
+      "steady state, its rotations and structure, or its end-of-cycle displacements match an "
       "experiment's (Ceres), with a 95% interval");
   cmd->add_option("--experiment", args->experiment, "the experiment's trajectory store (.h5)")
       ->required()
@@ -54,9 +55,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                       "(placed: 0.05,0.13,0.35,0.6, --refine 4), the joint fit 0.05,0.12,0.3, "
                       "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
   cmd->add_option("--window", args->window,
-                  "FIRST:LAST cycles whose end-of-cycle displacements are pooled; default the "
-                  "experiment's last 10; steady-state: auto, the longest window ending there "
-                  "over which the twin's runs are steady");
+                  "FIRST:LAST cycles compared (their window means, or their end-of-cycle "
+                  "displacements pooled); default the experiment's last 10; steady-state: "
+                  "auto, the longest window ending there over which the twin's runs are steady");
   cmd->add_option("--noise", args->noise,
                   "locating noise added to the simulated positions: none, fit, a value in voxels, "
                   "scans (the RMS of the position standard errors locate carried into the store), "

@@ -321,7 +321,7 @@ def _optional_float(value):
 
 
 def calibrate(experiment, out, mu_s=None, mu_r=None,
-              observables="displacements", only=(), window=None, noise="auto",
+              observables="steady-state", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
               refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
               true_mu_s=None, true_mu_r=None, parallel=0, progress=None, **twin):
@@ -331,9 +331,9 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     folder ``out`` (finished runs are reused when called again), and the friction fitted
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
     (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
-    window ending there over which the twin's runs are steady): "displacements" (the end-of-cycle
-    displacement distribution) or "steady-state" (window means of rotation, packing
-    fraction, coordination, wall force; ``only`` a subset). docs/CALIBRATION.md says which
+    window ending there over which the twin's runs are steady): "steady-state" (the default:
+    window means of rotation, packing fraction, coordination, wall force; ``only`` a
+    subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
     every run (``None``: 0, or 4 for a placed twin's own design). ``axis_noise``

@@ -916,7 +916,7 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
   m.def("calibrate", &calibrate_py, py::arg("experiment"), py::arg("out"),
         py::arg("mu_s") = py::none(), py::arg("mu_r") = py::none(),
-        py::arg("observables") = "displacements", py::arg("only") = std::vector<std::string>{},
+        py::arg("observables") = "steady-state", py::arg("only") = std::vector<std::string>{},
         py::arg("window") = py::none(), py::arg("noise") = "auto", py::arg("summaries") = "pooled",
         py::arg("wall_distance") = "0", py::arg("subtract_drift") = true,
         py::arg("degree") = CalibrateOptions{}.degree, py::arg("replicas") = py::none(),

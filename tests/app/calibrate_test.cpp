@@ -62,6 +62,20 @@ std::array<double, 2> expect_fit_in_its_interval(const std::string& json) {
   return {lo, hi};
 }
 
+// A fit compared with the experiment: at the twin's run nearest the fit where one lies inside
+// its interval (said, no simulation more), else at a run more, at the fit.
+void expect_compared_at_a_run_inside(const std::string& json, const std::string& report,
+                                     int design_runs) {
+  const auto [lo, hi] = expect_fit_in_its_interval(json);
+  bool inside = false;
+  std::istringstream simulated(json.substr(json.find("\"mu_s_simulated\": [") + 19));
+  for (double mu = 0; simulated >> mu; simulated.ignore(1))
+    inside = inside || (mu >= lo && mu <= hi);
+  EXPECT_EQ(json_value(json, "n_simulations"), design_runs + (inside ? 0 : 1)) << report;
+  EXPECT_EQ(report.find("compared at the twin's run nearest the fit") != std::string::npos, inside)
+      << report;
+}
+
 TEST_F(Calibrate, RefusesBadInput) {
   expect_clean_failure(calibrate({"--mu-s", ""}), {"--mu-s", "empty"});
   expect_clean_failure(calibrate({"--mu-s", "0.1,0.2"}), {"--mu-s", "needs at least"});
@@ -69,16 +83,21 @@ TEST_F(Calibrate, RefusesBadInput) {
   std::vector<std::string> other = kTwin;
   other[7] = "3%";  // the amplitude
   expect_clean_failure(calibrate({}, other), {"exp.h5", "amplitude 5%", "twin has 3%"});
-  expect_clean_failure(calibrate({"--noise", "fit"}), {"--noise", "voxel size"});
-  expect_clean_failure(calibrate({"--fit-only"}), {"--fit-only", "steady-state"});
-  expect_clean_failure(calibrate({"--window", "auto"}), {"--window auto", "steady-state"});
+  expect_clean_failure(calibrate({"--noise", "fit", "--observables", "displacements"}),
+                       {"--noise", "voxel size"});
+  expect_clean_failure(calibrate({"--fit-only", "--observables", "displacements"}),
+                       {"--fit-only", "steady-state"});
+  expect_clean_failure(calibrate({"--window", "auto", "--observables", "displacements"}),
+                       {"--window auto", "steady-state"});
   expect_clean_failure(
       calibrate({"--window", "auto", "--observables", "steady-state", "--replicas", "1"}),
       {"--window auto", "--replicas 2"});
 }
 
 TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
-  const RunResult r = granmem_ok(calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4"}));
+  const std::vector<std::string> fit{"--window",         "1:3",           "--mu-s",
+                                     "0.05,0.1,0.2,0.4", "--observables", "displacements"};
+  const RunResult r = granmem_ok(calibrate(fit));
   EXPECT_NE(r.out.find("mu_s = "), std::string::npos) << r.out;
   const std::string json = read_text(in_work("cal/summary.json"));
   for (const char* key : {"\"mu_s\"", "\"mu_s_ci95\"", "\"n_simulations\": 9", "\"replicas\": 2",
@@ -96,7 +115,7 @@ TEST_F(Calibrate, WritesTheFitItsIntervalAndFigures) {
     EXPECT_TRUE(std::filesystem::exists(in_work(f))) << f;
   }
   // Run again: the runs are reused, the answer is the same.
-  const RunResult again = granmem_ok(calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4"}));
+  const RunResult again = granmem_ok(calibrate(fit));
   EXPECT_NE(again.err.find("reusing"), std::string::npos);
   auto fit_line = [](const std::string& out) {
     const std::string from = out.substr(out.find("mu_s = "));
@@ -150,7 +169,8 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   };
   EXPECT_DOUBLE_EQ(rotation(noisy, "experiment"), rotation(exact, "experiment"));
   EXPECT_GT(rotation(noisy, "model_at_fit"), rotation(exact, "model_at_fit"));
-  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--axis-noise", "1"}),
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--axis-noise", "1",
+                                  "--observables", "displacements"}),
                        {"--axis-noise", "steady-state"});
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--axis-noise", "-1"}),
@@ -162,7 +182,8 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--true-mu-s", "0.1,0.2"}),
                        {"--true-mu-s", "one friction"});
-  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--true-mu-s", "0.2"}),
+  expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--true-mu-s", "0.2",
+                                  "--observables", "displacements"}),
                        {"--true-mu-s", "steady-state"});
   expect_clean_failure(calibrate({"--mu-s", "0.05,0.1,0.2,0.4", "--observables", "steady-state",
                                   "--true-mu-r", "0.01"}),
@@ -198,8 +219,8 @@ TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
     f.position_error = Eigen::RowVector3d(5e-5, 5e-5, 7.5e-5).replicate(f.position.rows(), 1);
   write_trajectories(in_work("scans.h5"), run);
   std::vector<std::string> a{
-      "calibrate", "--experiment", "scans.h5",         "--out",   "cal",  "--window",
-      "1:3",       "--mu-s",       "0.05,0.1,0.2,0.4", "--noise", "scans"};
+      "calibrate", "--experiment",     "scans.h5", "--out", "cal",           "--window",     "1:3",
+      "--mu-s",    "0.05,0.1,0.2,0.4", "--noise",  "scans", "--observables", "displacements"};
   a.insert(a.end(), kTwin.begin(), kTwin.end());
   granmem_ok(a);
   const std::string json = read_text(in_work("cal/summary.json"));
@@ -207,25 +228,26 @@ TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
   EXPECT_NEAR(json_value(json, "noise_sigma_voxel"), 0.5, 1e-12);
   EXPECT_EQ(json_value(json, "noise_sigma_error"), 0);  // given, not fitted
   // auto takes them too where the store has them (the same runs, reused).
-  std::vector<std::string> automatic{"calibrate", "--experiment", "scans.h5",
-                                     "--out",     "cal",          "--window",
-                                     "1:3",       "--mu-s",       "0.05,0.1,0.2,0.4"};
+  std::vector<std::string> automatic{
+      "calibrate", "--experiment", "scans.h5",         "--out",         "cal",          "--window",
+      "1:3",       "--mu-s",       "0.05,0.1,0.2,0.4", "--observables", "displacements"};
   automatic.insert(automatic.end(), kTwin.begin(), kTwin.end());
   granmem_ok(automatic);
   const std::string json_auto = read_text(in_work("cal/summary.json"));
   EXPECT_NE(json_auto.find("\"noise_model\": \"scans\""), std::string::npos) << json_auto;
   EXPECT_NEAR(json_value(json_auto, "noise_sigma_voxel"), 0.5, 1e-12);
   // A store without them: one clear error.
-  expect_clean_failure(
-      calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4", "--noise", "scans"}),
-      {"--noise scans", "no position standard errors"});
+  expect_clean_failure(calibrate({"--window", "1:3", "--mu-s", "0.05,0.1,0.2,0.4", "--noise",
+                                  "scans", "--observables", "displacements"}),
+                       {"--noise scans", "no position standard errors"});
 }
 
 // --refine: the design's fit, then packings of new seeds at it, and the fit again on all
 // runs, their held-out runs at the refined friction counted in the cross-validation.
 TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
-  expect_clean_failure(calibrate({"--refine", "2", "--mu-s", "0.05,0.1,0.4"}),
-                       {"--refine", "steady-state"});
+  expect_clean_failure(
+      calibrate({"--refine", "2", "--mu-s", "0.05,0.1,0.4", "--observables", "displacements"}),
+      {"--refine", "steady-state"});
   const std::vector<std::string> design{
       "--window", "2:3", "--mu-s", "0.05,0.1,0.4", "--observables", "steady-state", "--fit-only"};
   const RunResult first = granmem_ok(calibrate(design));
@@ -290,6 +312,11 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   // Placed runs are reused only for the same packing placed the same way.
   std::vector<std::string> again = design;
   EXPECT_NE(granmem_ok(calibrate(again)).err.find("reusing 6 finished runs"), std::string::npos);
+  // Compared with the experiment: the truth, 0.2, is a run of this design.
+  again.erase(std::find(again.begin(), again.end(), "--fit-only"));
+  const RunResult compared_design = granmem_ok(calibrate(again));
+  expect_compared_at_a_run_inside(read_text(in_work("cal/summary.json")), compared_design.out, 6);
+  again.push_back("--fit-only");
   again.insert(again.end(), {"--placed-jitter", "1um"});
   EXPECT_EQ(granmem_ok(calibrate(again)).err.find("reusing"), std::string::npos);
   again.back() = "0um";
@@ -315,6 +342,12 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   const std::string staged_json = read_text(in_work("staged/summary.json"));
   EXPECT_EQ(json_value(staged_json, "n_simulations"), refined ? 12 : 8) << own.out;
   EXPECT_EQ(json_value(staged_json, "refined"), refined ? 4 : 0) << staged_json;
+  // Compared with the experiment (no --fit-only): at a refined packing where one lies inside
+  // the interval, no simulation more; else at the fit, one more.
+  staged.erase(std::find(staged.begin(), staged.end(), "--fit-only"));
+  const RunResult compared = granmem_ok(staged);
+  const std::string compared_json = read_text(in_work("staged/summary.json"));
+  expect_compared_at_a_run_inside(compared_json, compared.out, refined ? 12 : 8);
   std::vector<std::string> poured = design;
   poured.insert(poured.end(), {"--deposit", "each"});
   granmem_ok(calibrate(poured));  // the same folder: poured runs are other runs, not reused
@@ -347,8 +380,9 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {
-  expect_clean_failure(calibrate({"--fit", "mu_s,mu_r", "--mu-s", "0.05,0.2,0.4"}),
-                       {"--fit mu_s,mu_r", "steady-state"});
+  expect_clean_failure(
+      calibrate({"--fit", "mu_s,mu_r", "--mu-s", "0.05,0.2,0.4", "--observables", "displacements"}),
+      {"--fit mu_s,mu_r", "steady-state"});
   expect_clean_failure(
       calibrate({"--fit", "mu_s,mu_r", "--mu-s", "0.05,0.2,0.4", "--observables", "steady-state"}),
       {"--mu-r", "at least 3"});

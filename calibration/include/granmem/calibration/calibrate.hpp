@@ -58,7 +58,9 @@ struct CalibrateOptions {
   // The rolling frictions simulated in a joint fit of mu_s and mu_r (every mu_s x mu_r);
   // empty: mu_s alone, at the twin's own mu_r.
   std::vector<double> mu_r;
-  CalibrationObservables observables = CalibrationObservables::displacements;
+  // The steady state by default: its rotation and structure pin mu_s, the end-of-cycle
+  // displacements hardly (docs/CALIBRATION.md, "Which observables identify friction").
+  CalibrationObservables observables = CalibrationObservables::steady_state;
   std::vector<std::string> only;  // steady state: these observables only (default all)
   // Cycles whose observables are compared; default the experiment's last 10.
   std::optional<std::pair<std::int64_t, std::int64_t>> window;

@@ -155,13 +155,16 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
 
   cmd->callback([args, given, simulate, mu_s_option] {
     CalibrateOptions o;
-    // The twin: simulate's defaults, then the config's [simulate], then calibrate's own.
+    // The twin: simulate's defaults, then the config's [simulate], then calibrate's own;
+    // the protocol's settings none of them sets are the experiment's (resolved_options()).
     o.twin = simulate.args->value;
     for (const auto& [name, option] : simulate.given) {
-      if (option->count() == 0) o.twin[name] = simulate.args->value.at(name);
+      if (option->count() > 0) o.twin_given.insert(name);
     }
     for (const auto& [name, option] : given) {
-      if (option->count() > 0) o.twin[name] = args->twin.at(name);
+      if (option->count() == 0) continue;
+      o.twin[name] = args->twin.at(name);
+      o.twin_given.insert(name);
     }
     o.experiment = args->experiment;
     o.out = args->out;

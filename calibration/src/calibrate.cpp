@@ -66,13 +66,10 @@ std::vector<double> sorted(std::vector<double> v) {
   return v;
 }
 
-// Settings that make the protocol: a pseudo-experiment simulated by granmem says what it
-// used, and they must agree with the twin's.
+// The protocol a pseudo-experiment's store says must agree with the twin's.
 void check_against_experiment(const RunHeader& experiment, const std::string& file,
                               const RunSettings& twin, double box) {
-  for (const char* key :
-       {"grains", "box", "diameter", "amplitude", "drive", "wall-motion", "lid-mass",
-        "lid-pressure", "period", "inertial-number", "polydispersity"}) {
+  for (const char* key : kProtocolSettings) {
     const auto it = experiment.parameters.find(std::string("simulate/") + key);
     if (it != experiment.parameters.end() && it->second != twin.at(key)) {
       throw Error(file + ": the experiment was simulated with --" + key + " " + it->second +
@@ -134,6 +131,11 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
 CalibrateOptions resolved_options(const CalibrateOptions& given,
                                   const TrajectoryReader& experiment) {
   CalibrateOptions options = given;
+  for (const char* key : kProtocolSettings) {
+    const auto it = experiment.header().parameters.find(std::string("simulate/") + key);
+    if (it != experiment.header().parameters.end() && !given.twin_given.count(key))
+      options.twin[key] = it->second;
+  }
   options.preparation = resolved_preparation(given, experiment);
   return options.with_default_design();
 }
@@ -361,8 +363,24 @@ class Twin {
     return specs;
   }
 
+  // The protocol settings taken from a pseudo-experiment's store (resolved_options()), where
+  // they are not simulate's defaults: what the twin was not told and did not guess.
+  void note_protocol_taken() const {
+    const RunSettings defaults = default_simulate_settings();
+    std::string taken;
+    for (const char* key : kProtocolSettings) {
+      const auto it = experiment_.header().parameters.find(std::string("simulate/") + key);
+      if (it == experiment_.header().parameters.end() || o_.twin_given.count(key) ||
+          it->second == defaults.at(key))
+        continue;
+      taken += std::string(taken.empty() ? "" : ", ") + "--" + key + " " + it->second;
+    }
+    if (!taken.empty()) say("the twin's protocol from the experiment's store: " + taken);
+  }
+
   void announce() const {
     note_experiment_seed();
+    note_protocol_taken();
     note_located_grains();
     std::ostringstream line;
     std::string mu;

@@ -761,8 +761,9 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   CalibrateOptions o;
   o.experiment = experiment;
   o.out = out;
-  set_settings(twin, o.twin, is_twin_setting,
-               "calibrate: '%' is not a setting of the twin (see granmem calibrate --help)");
+  o.twin_given =
+      set_settings(twin, o.twin, is_twin_setting,
+                   "calibrate: '%' is not a setting of the twin (see granmem calibrate --help)");
   if (mu_s) o.mu_s = parse_frictions(*mu_s, "mu_s");
   if (mu_r) o.mu_r = parse_frictions(*mu_r, "mu_r");
   if (observables != "displacements" && observables != "steady-state") {

@@ -322,12 +322,15 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   again.back() = "0um";
   expect_clean_failure(calibrate(again), {"--placed-jitter", "> 0"});
   // The design left out: a placed twin's own, 2 packings x 0.05, 0.13, 0.35, 0.6, then 4
-  // packings of new seeds where those 8 fit (unless at the range's edge).
-  std::vector<std::string> staged{"calibrate", "--experiment",  "exp.h5",       "--out",
-                                  "staged",    "--observables", "steady-state", "--window",
-                                  "2:3",       "--fit-only"};
-  staged.insert(staged.end(), kTwin.begin(), kTwin.end());
+  // packings of new seeds where those 8 fit (unless at the range's edge). The protocol left
+  // out too (the default observables, the steady state's): the pseudo-experiment's own.
+  std::vector<std::string> staged{"calibrate", "--experiment", "exp.h5", "--out",
+                                  "staged",    "--window",     "2:3",    "--fit-only"};
   const RunResult own = granmem_ok(staged);
+  EXPECT_NE(own.err.find("the twin's protocol from the experiment's store: --grains 60, --box "
+                         "2cm, --amplitude 5%, --lid-mass 0.2kg, --period 0.1s"),
+            std::string::npos)
+      << own.err;
   EXPECT_NE(own.err.find("mu_s 0.05,0.13,0.35,0.6, 2 packing(s) from seed 1, then 4 more"),
             std::string::npos)
       << own.err;

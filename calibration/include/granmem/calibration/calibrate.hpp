@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,6 +34,11 @@ enum class CalibrationObservables { displacements, steady_state };
 // where its first frame holds it exactly (exact_first_packing()) and the fit is mu_s's on
 // the steady state, where it was measured (docs/CALIBRATION.md); else each its own.
 enum class TwinPreparation { each, shared, experiment, automatic };
+// The settings that make the protocol: a pseudo-experiment simulated by granmem says what
+// it used, the twin takes them where its caller did not set them, and they must agree.
+inline constexpr const char* kProtocolSettings[] = {
+    "grains",   "box",          "diameter", "amplitude",       "drive",         "wall-motion",
+    "lid-mass", "lid-pressure", "period",   "inertial-number", "polydispersity"};
 // The jitter of a replica of the experiment's packing (m per coordinate, in grain
 // diameters): what stands for the microstate a frame does not hold (contact forces,
 // velocities), small enough not to move the placed packing (its springs' overlaps under the
@@ -53,6 +59,10 @@ struct CalibrateOptions {
   std::filesystem::path experiment;  // the experiment's trajectory store
   std::filesystem::path out;         // summary, tables, figures; the twin's runs in out/runs
   RunSettings twin = default_simulate_settings();  // the twin's `simulate` settings
+  // The twin's settings the caller set (a config, the command line, Python's keywords). The
+  // protocol's others (kProtocolSettings) are a pseudo-experiment's own where its store says
+  // them: the twin is given the experiment's protocol unless told otherwise.
+  std::set<std::string> twin_given;
   // The frictions simulated; empty: the observables' own design (with_default_design()).
   std::vector<double> mu_s;
   // The rolling frictions simulated in a joint fit of mu_s and mu_r (every mu_s x mu_r);
@@ -127,7 +137,8 @@ struct CalibrateOptions {
 // The preparation `options` ask for, automatic resolved for `experiment`.
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
                                      const TrajectoryReader& experiment);
-// The options calibrate() runs: the preparation resolved for `experiment`, then the design
+// The options calibrate() runs: the twin's protocol settings not in twin_given taken from a
+// pseudo-experiment's store, the preparation resolved for `experiment`, then the design
 // where `given` leaves it (with_default_design(): a placed twin's own).
 CalibrateOptions resolved_options(const CalibrateOptions& given,
                                   const TrajectoryReader& experiment);

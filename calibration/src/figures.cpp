@@ -19,6 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Tic labels such as "0.246" that fit side by side across a 420-pixel panel's plot.
+constexpr double kLabelsAcrossAPanel = 7;
+
 // A perceptual, colour-blind-safe map (matplotlib's viridis, 9 stops).
 constexpr const char* kViridis =
     "set palette defined (0 '#440154', 1 '#472d7b', 2 '#3b528b', 3 '#2c728e', 4 '#21918c', "
@@ -95,9 +98,12 @@ std::vector<fs::path> draw(const fs::path& dir, const std::string& name, const s
 }
 
 // Log axes spanning about a decade get too few tics: the design's own values instead, but
-// not one within 20 % of another (a refined run beside a design's: their labels overlap),
-// the values with more runs first, then the rounder (a design's 0.4 before a fit's 0.367).
-std::string design_tics(const std::vector<double>& runs) {
+// not one nearer another than a label's width, 1/`slots` of the axis `range` in log (and
+// 20 %): a refined run's beside a design's would overlap; the values with more runs first,
+// then the rounder (a design's 0.4 before a fit's 0.367).
+std::string design_tics(const std::vector<double>& runs, std::array<double, 2> range,
+                        double slots) {
+  const double apart = std::max(1.2, std::pow(range[1] / range[0], 1 / slots));
   std::map<double, int> count;
   for (double x : runs)
     ++count[x];
@@ -114,7 +120,7 @@ std::string design_tics(const std::vector<double>& runs) {
   for (const auto& run : by_runs) {
     const double x = run.first;  // a plain name: C++17 lambdas cannot capture a binding
     const bool crowded = std::any_of(tics.begin(), tics.end(),
-                                     [&](double t) { return std::max(x / t, t / x) < 1.2; });
+                                     [&](double t) { return std::max(x / t, t / x) < apart; });
     if (!crowded) tics.insert(x);
   }
   std::ostringstream t;
@@ -280,7 +286,7 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
   plot << "set multiplot layout " << rows << "," << columns << " title " << quoted(title)
        << "\nset logscale x\nset xlabel \"mu_s\"\nset key off\nset grid\n"
        << "set xrange [" << lowest << ":" << highest << "]\nset xtics "
-       << design_tics(panels.front().run_mu_s) << "\n"
+       << design_tics(panels.front().run_mu_s, {lowest, highest}, kLabelsAcrossAPanel) << "\n"
        << "set object 1 rect from " << (ci95[0] > lowest ? ci95[0] : lowest) << ", graph 0 to "
        << (ci95[1] < highest ? ci95[1] : highest)
        << ", graph 1 behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
@@ -353,12 +359,13 @@ std::vector<fs::path> plot_joint_region(const fs::path& dir, const std::string& 
   for (const auto& p : region)
     extend(p[0], p[1]);
   const std::string file = quoted(name + ".dat");
-  plot << "set xtics " << design_tics(run_x) << "\nset ytics " << design_tics(run_y)
-       << "\nset title " << quoted(title)
+  const std::array<double, 2> x_range{lo[0] / 1.4, hi[0] * 1.4}, y_range{lo[1] / 1.4, hi[1] * 1.4};
+  plot << "set xtics " << design_tics(run_x, x_range, 2 * kLabelsAcrossAPanel) << "\nset ytics "
+       << design_tics(run_y, y_range, 2 * kLabelsAcrossAPanel) << "\nset title " << quoted(title)
        << "\nset logscale xy\nset xlabel \"sliding friction mu_s\""
        << "\nset ylabel \"rolling friction mu_r\"\nset key outside bottom center horizontal\n"
-       << "set xrange [" << lo[0] / 1.4 << ":" << hi[0] * 1.4 << "]\nset yrange [" << lo[1] / 1.4
-       << ":" << hi[1] * 1.4 << "]\n"
+       << "set xrange [" << x_range[0] << ":" << x_range[1] << "]\nset yrange [" << y_range[0]
+       << ":" << y_range[1] << "]\n"
        << "plot " << file
        << " index 1 using 1:2 with filledcurves closed fc rgb \"#f4a582\" fs solid 0.45 "
           "title \"joint 95 % region\", "

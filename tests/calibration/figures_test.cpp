@@ -56,5 +56,25 @@ TEST_F(Figures, AnUnboundedIntervalIsDrawnToTheEdges) {
   EXPECT_NE(gp.find("set xrange [0.04:0.5]"), std::string::npos) << gp;
 }
 
+// The frictions' tics are the design's own, but no two labels nearer than a label's width
+// across the panel: the refined runs' 0.246 (four packings) keeps its label, the design's
+// 0.35 beside it does not (1.42x apart on an axis of 0.04-0.75).
+TEST_F(Figures, TicsOfFrictionsDoNotOverlap) {
+  ObservablePanel panel;
+  panel.label = "packing fraction";
+  panel.run_mu_s = {0.05, 0.05, 0.13, 0.13, 0.246, 0.246, 0.246, 0.246, 0.35, 0.35, 0.6, 0.6};
+  panel.run_value.assign(panel.run_mu_s.size(), 0.56);
+  panel.run_packing.assign(panel.run_mu_s.size(), 0);
+  panel.curve_mu_s = panel.run_mu_s;
+  panel.curve = panel.run_value;
+  panel.experiment = 0.56;
+  panel.experiment_error = 0.001;
+  plot_observable_fit(dir_, "fit", {panel}, 0.236, {0.217, 0.256}, 0.23, "tics");
+  const std::string gp = read_all(dir_ / "fit.gp");
+  EXPECT_NE(gp.find("set xtics (\"0.05\" 0.05, \"0.13\" 0.13, \"0.246\" 0.246, \"0.6\" 0.6)"),
+            std::string::npos)
+      << gp;
+}
+
 }  // namespace
 }  // namespace granmem

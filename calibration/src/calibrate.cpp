@@ -577,8 +577,10 @@ class Twin {
     series.protocol.cycles = observe.window.second;
     series.protocol.drive = drive_from(settings_, physics_, deposit_.box_side, deposit_.box_side,
                                        deposit_.lid_mass, deposit_.radius);
+    // The twin's own settings only: what calibrate sets per run (cycles, mu_s) is written
+    // as such, not as a config's leftover that would keep a finished run from being reused.
     for (const auto& [key, value] : settings_)
-      series.protocol.parameters["simulate/" + key] = value;
+      if (is_twin_setting(key)) series.protocol.parameters["simulate/" + key] = value;
     series.protocol.parameters["calibrate/deposit"] = preparation_name(o_.preparation);
     if (placed_) {  // runs placed from another experiment's packing are other runs
       series.protocol.parameters["calibrate/placed_from"] = placed_identity();
@@ -652,12 +654,21 @@ FrictionRunSpec compared_run(const std::vector<FrictionRunSpec>& specs,
 
 // The line that says which run the comparison is at, where it is not a run at the fit.
 std::string compared_run_line(const FrictionRunSpec& compared, const FrictionRunSpec& at_fit) {
-  if (compared.mu_s == at_fit.mu_s && compared.mu_r == at_fit.mu_r) return {};
+  if (compared.mu_s == at_fit.mu_s && compared.mu_r == at_fit.mu_r && compared.seed == at_fit.seed)
+    return {};
   std::string line =
       "compared at the twin's run nearest the fit, mu_s " + number_text(compared.mu_s);
   if (compared.mu_r >= 0) line += ", mu_r " + number_text(compared.mu_r);
   return line + " (seed " + std::to_string(compared.seed) +
          "), inside the 95% interval: no simulation more\n";
+}
+
+// "12 simulations", and where the comparison took one more at the fit, says so: the fit's
+// own runs are the design's.
+std::string simulations_text(std::size_t fitted, std::size_t simulated) {
+  std::string text = std::to_string(fitted) + " simulations";
+  if (simulated > fitted) text += ", 1 more at the fit for the comparison";
+  return text;
 }
 
 // The twin at the fit (unless fit_only) compared with the experiment: the distances, the
@@ -1091,6 +1102,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["chi2"] = fit.chi2;
   j["dof"] = fit.dof;
   j["n_simulations"] = s.simulations;
+  j["n_simulations_fitted"] = specs.size();
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["axis_noise_deg"] = twin.observe.axis_noise * 180 / M_PI;
@@ -1112,7 +1124,8 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
-         << " - " << fit.mu_s_ci95[1] << ", " << s.simulations << " simulations)";
+         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(specs.size(), s.simulations)
+         << ")";
   if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
   report << "\n" << observables_line(twin, fit.names, &fit.resolution);
   report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
@@ -1170,6 +1183,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   j["dof"] = fit.dof;
   j["region95"] = fit.region95;
   j["n_simulations"] = s.simulations;
+  j["n_simulations_fitted"] = specs.size();
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["observables"] = fit.names;
@@ -1184,8 +1198,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   report << "\nmu_r = " << fit.mu_r << "  (95% interval " << fit.mu_r_ci95[0] << " - "
          << fit.mu_r_ci95[1] << ")";
   if (std::isfinite(s.true_mu_r)) report << "  true " << s.true_mu_r;
-  report << "\n  correlation of ln mu_s and ln mu_r " << fit.correlation << ", " << s.simulations
-         << " simulations\n"
+  report << "\n  correlation of ln mu_s and ln mu_r " << fit.correlation << ", "
+         << simulations_text(specs.size(), s.simulations) << "\n"
          << observables_line(twin, fit.names, nullptr) << "  chi2 " << fit.chi2 << " for "
          << fit.dof << " dof; cross-validated " << fit.cross_validated_sigma[0] << " (mu_s), "
          << fit.cross_validated_sigma[1] << " (mu_r) in ln at the fit from "
@@ -1289,6 +1303,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
   j["mu_s_ci95"] = s.mu_s_ci95;
   j["mu_s_interval_method"] = fit.method;
   j["n_simulations"] = s.simulations;
+  j["n_simulations_fitted"] = specs.size();
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["summaries"] = o.per_cycle ? "per-cycle" : "pooled";
@@ -1310,7 +1325,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
 
   const std::vector<double> mu = sorted(o.mu_s);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
-         << " - " << fit.mu_s_ci95[1] << ", " << s.simulations << " simulations"
+         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(specs.size(), s.simulations)
          << (fit.converged ? "" : ", fit NOT converged") << ")\n"
          << "  at the fit: KS " << ks << ", Wasserstein-1 " << w1 << " d (end-of-cycle dr); chi2 "
          << fit.chi2 << " for " << fit.dof << " dof; realization scatter x" << fit.overdispersion

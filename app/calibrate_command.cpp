@@ -49,11 +49,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out,-o", args->out, "output folder")->required();
-  CLI::Option* mu_s_option =
-      cmd->add_option("--mu-s", args->mu_s,
-                      "the frictions simulated, comma list; default steady-state 0.05,0.1,0.2,0.4 "
-                      "(placed: 0.05,0.13,0.35,0.6, --refine 4), the joint fit 0.05,0.12,0.3, "
-                      "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
+  CLI::Option* mu_s_option = cmd->add_option(
+      "--mu-s", args->mu_s,
+      "the frictions simulated, comma list; default steady-state 0.05,0.14,0.4, --refine 3 "
+      "(placed: 0.05,0.13,0.35,0.6, --refine 4), the joint fit 0.05,0.12,0.3, "
+      "displacements 0.03,0.05,0.08,0.12,0.2,0.3,0.5");
   cmd->add_option("--window", args->window,
                   "FIRST:LAST cycles compared (their window means, or their end-of-cycle "
                   "displacements pooled); default the experiment's last 10; steady-state: "
@@ -86,8 +86,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
                   "--replicas design, each its own seed, and the fit made again on every run "
-                  "(they measure one packing's scatter where the experiment is); default 0, "
-                  "placed with --mu-s and --replicas left out 4")
+                  "(they measure one packing's scatter where the experiment is); default 0, with "
+                  "--mu-s and --replicas left out 3 (placed 4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "

@@ -1354,11 +1354,12 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
   const bool steady = observables == CalibrationObservables::steady_state;
   // A placed twin's replicas differ by their jitter alone and scatter little, so two per
   // friction measure it; its range reaches past 0.4, and its last four packings go where
-  // the first eight fit.
+  // the first eight fit. A poured twin's packings scatter more: three per friction, and
+  // three more at their fit.
   const Design design = joint() ? Design{{0.05, 0.12, 0.3}, 2}
                         : steady && preparation == TwinPreparation::experiment
                             ? Design{{0.05, 0.13, 0.35, 0.6}, 2, 4}
-                        : steady ? Design{{0.05, 0.1, 0.2, 0.4}, 3}
+                        : steady ? Design{{0.05, 0.14, 0.4}, 3, 3}
                                  : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
   // A design given is run as given: refined only where asked.

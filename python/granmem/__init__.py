@@ -336,7 +336,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
-    every run (``None``: 0, or 4 for a placed twin's own design). ``axis_noise``
+    every run (``None``: 0, or the design's own where ``mu_s`` and ``replicas`` are left: 3, placed 4). ``axis_noise``
     (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
     the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
@@ -349,8 +349,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     holds it exactly, else "each").
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
-    "steady-state" 0.05, 0.1, 0.2, 0.4 on 3 packings (12 runs; a twin placed from the
-    experiment's packing 0.05, 0.13, 0.35, 0.6 on 2, then 4 more at their fit), for the
+    "steady-state" 0.05, 0.14, 0.4 on 3 packings, then 3 more at their fit (12 runs; a twin
+    placed from the experiment's packing 0.05, 0.13, 0.35, 0.6 on 2, then 4 more at their fit), for the
     joint fit 0.05, 0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08,
     0.12, 0.2, 0.3, 0.5 on 2.
 

@@ -12,12 +12,12 @@ namespace granmem {
 namespace {
 
 TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
-  CalibrateOptions steady;
-  steady.observables = CalibrationObservables::steady_state;
+  CalibrateOptions steady;  // the steady state: the default observables
+  EXPECT_EQ(steady.observables, CalibrationObservables::steady_state);
   const CalibrateOptions s = steady.with_default_design();
-  EXPECT_EQ(s.mu_s, (std::vector<double>{0.05, 0.1, 0.2, 0.4}));
-  EXPECT_EQ(s.replicas, 3);  // 12 runs: the grid of the steady-state pseudo-experiments
-  EXPECT_EQ(s.refine, 0);
+  EXPECT_EQ(s.mu_s, (std::vector<double>{0.05, 0.14, 0.4}));
+  EXPECT_EQ(s.replicas, 3);  // 12 runs: the refined design of the poured pseudo-experiments
+  EXPECT_EQ(s.refine, 3);
   EXPECT_NO_THROW(s.validate());
   CalibrateOptions placed = steady;
   placed.preparation = TwinPreparation::experiment;
@@ -30,7 +30,9 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   unrefined.refine = 0;
   EXPECT_EQ(unrefined.with_default_design().refine, 0);
   EXPECT_EQ(unrefined.with_default_design().mu_s.size(), 4u);
-  const CalibrateOptions d = CalibrateOptions{}.with_default_design();
+  CalibrateOptions displacements;
+  displacements.observables = CalibrationObservables::displacements;
+  const CalibrateOptions d = displacements.with_default_design();
   EXPECT_EQ(d.mu_s, (std::vector<double>{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}));
   EXPECT_EQ(d.replicas, 2);
   CalibrateOptions joint = steady;
@@ -38,12 +40,13 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   const CalibrateOptions j = joint.with_default_design();
   EXPECT_EQ(j.mu_s, (std::vector<double>{0.05, 0.12, 0.3}));
   EXPECT_EQ(j.replicas, 2);  // x 3 mu_r: the 18 runs of the measured joint fits
-  steady.mu_s = {0.05, 0.14, 0.4};
+  steady.mu_s = {0.05, 0.1, 0.2, 0.4};
   steady.replicas = 4;
   const CalibrateOptions given = steady.with_default_design();
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 4);
-  placed.mu_s = steady.mu_s;  // a placed design given is run as given: refined if asked
+  EXPECT_EQ(given.refine, 0);  // a design given is run as given
+  placed.mu_s = steady.mu_s;   // a placed design given is run as given: refined if asked
   EXPECT_EQ(placed.with_default_design().refine, 0);
   placed.refine = 2;
   EXPECT_EQ(placed.with_default_design().refine, 2);
@@ -75,7 +78,7 @@ class ResolvedOptions : public testing::TempDirTest {
   }
 };
 
-TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
+TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneItsOwn) {
   CalibrateOptions steady;
   steady.observables = CalibrationObservables::steady_state;
   const TrajectoryReader simulation(store(false));
@@ -88,8 +91,8 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneTheGrid) {
   EXPECT_EQ(poured.preparation, TwinPreparation::each);
   EXPECT_EQ(poured.mu_s.back(), 0.4);
   EXPECT_EQ(poured.replicas, 3);
-  EXPECT_EQ(poured.refine, 0);
-  CalibrateOptions each = steady;  // a simulation poured when asked: the grid
+  EXPECT_EQ(poured.refine, 3);
+  CalibrateOptions each = steady;  // a simulation poured when asked: the poured design
   each.preparation = TwinPreparation::each;
   EXPECT_EQ(resolved_options(each, simulation).mu_s.back(), 0.4);
   steady.mu_s = {0.1, 0.2, 0.4};  // a design given is kept, placed or not

@@ -121,8 +121,8 @@ struct CalibrateOptions {
 
   bool joint() const { return !mu_r.empty(); }
   // These options with the twin's design where they leave it, the one docs/CALIBRATION.md
-  // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.1, 0.2, 0.4 (12
-  // runs), placed (TwinPreparation::experiment, as resolved_preparation() gives it) 2 x
+  // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.14, 0.4 and 3
+  // packings more at that fit (refine, 12 runs), placed (TwinPreparation::experiment, as resolved_preparation() gives it) 2 x
   // 0.05, 0.13, 0.35, 0.6 and 4 packings more at that fit (refine, 12 runs reaching past
   // 0.4), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r), for the displacements
   // 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.

@@ -86,8 +86,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
                   "--replicas design, each its own seed, and the fit made again on every run "
-                  "(they measure one packing's scatter where the experiment is); default 0, with "
-                  "--mu-s and --replicas left out 3 (placed 4)")
+                  "(they measure one packing's scatter where the experiment is); default 0, but "
+                  "3 for a steady-state fit of mu_s with --mu-s and --replicas left out (placed "
+                  "4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "

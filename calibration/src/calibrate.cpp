@@ -66,6 +66,17 @@ std::vector<double> sorted(std::vector<double> v) {
   return v;
 }
 
+// Whether a shared packing was poured with these settings: the twin's own and the friction
+// it was poured at, not what calibrate sets per run (cycles, output).
+bool same_packing_settings(const RunSettings& a, const RunSettings& b) {
+  for (const auto& [key, value] : b) {
+    if (!is_twin_setting(key) && key != "mu-s") continue;
+    const auto it = a.find(key);
+    if (it == a.end() || it->second != value) return false;
+  }
+  return true;
+}
+
 // The protocol a pseudo-experiment's store says must agree with the twin's.
 void check_against_experiment(const RunHeader& experiment, const std::string& file,
                               const RunSettings& twin, double box) {
@@ -131,10 +142,12 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
 CalibrateOptions resolved_options(const CalibrateOptions& given,
                                   const TrajectoryReader& experiment) {
   CalibrateOptions options = given;
+  const RunSettings defaults = default_simulate_settings();
   for (const char* key : kProtocolSettings) {
     const auto it = experiment.header().parameters.find(std::string("simulate/") + key);
-    if (it != experiment.header().parameters.end() && !given.twin_given.count(key))
-      options.twin[key] = it->second;
+    // Set by the caller: in twin_given, or away from simulate's default (a library caller's).
+    const bool set = given.twin_given.count(key) || given.twin.at(key) != defaults.at(key);
+    if (it != experiment.header().parameters.end() && !set) options.twin[key] = it->second;
   }
   options.preparation = resolved_preparation(given, experiment);
   return options.with_default_design();
@@ -505,7 +518,7 @@ class Twin {
       if (fs::exists(path)) {
         ProtocolState state;
         shared_.emplace(seed, read_checkpoint(path, &state));
-        if (state.settings != settings) {
+        if (!same_packing_settings(state.settings, settings)) {
           throw Error(path.string() + ": deposited with other settings; remove it or " +
                       "choose another --out");
         }
@@ -581,6 +594,8 @@ class Twin {
     // as such, not as a config's leftover that would keep a finished run from being reused.
     for (const auto& [key, value] : settings_)
       if (is_twin_setting(key)) series.protocol.parameters["simulate/" + key] = value;
+    if (o_.preparation == TwinPreparation::shared)  // its packings poured at this friction
+      series.protocol.parameters["simulate/mu-s"] = settings_.at("mu-s");
     series.protocol.parameters["calibrate/deposit"] = preparation_name(o_.preparation);
     if (placed_) {  // runs placed from another experiment's packing are other runs
       series.protocol.parameters["calibrate/placed_from"] = placed_identity();
@@ -590,21 +605,28 @@ class Twin {
     return series;
   }
 
-  void note_experiment_seed() const {
-    const auto seed = experiment_.header().parameters.find("simulate/seed");
-    // A placed twin's seeds draw jitters, not pours: no seed repeats the experiment's packing.
-    if (seed == experiment_.header().parameters.end() ||
+ public:
+  // Whether the twin's packings of this seed pour the experiment's own grains (a
+  // pseudo-experiment poured with it). A placed twin's seeds draw jitters, not pours.
+  bool pours_experiments_grains(std::uint64_t seed) const {
+    const auto stored = experiment_.header().parameters.find("simulate/seed");
+    if (stored == experiment_.header().parameters.end() ||
         o_.preparation == TwinPreparation::experiment)
-      return;
-    std::uint64_t s = 0;
+      return false;
     try {
-      s = std::stoull(seed->second);
+      return std::stoull(stored->second) == seed;
     } catch (const std::exception&) {
-      return;
+      return false;
     }
-    if (std::count(seeds_.begin(), seeds_.end(), s)) {
-      say("note: the twin's seeds include the experiment's (" + seed->second +
-          "): one twin run pours the experiment's own grains");
+  }
+
+ private:
+  void note_experiment_seed() const {
+    for (std::uint64_t s : seeds_) {
+      if (pours_experiments_grains(s)) {
+        say("note: the twin's seeds include the experiment's (" + std::to_string(s) +
+            "): one twin run pours the experiment's own grains");
+      }
     }
   }
 
@@ -630,23 +652,21 @@ std::size_t simulations_with(const Twin& twin, const std::vector<FrictionRunSpec
 }
 
 // The run the experiment is compared with: the twin's run nearest the fit (in ln mu_s, and
-// ln mu_r jointly) where one lies inside the fit's 95 % intervals, as the data cannot tell
-// it from the fit and it costs no simulation more (a staged design's refined packings
-// usually do); else `at_fit`, run for the comparison.
-FrictionRunSpec compared_run(const std::vector<FrictionRunSpec>& specs,
-                             const FrictionRunSpec& at_fit, std::array<double, 2> mu_s_ci95,
-                             std::optional<std::array<double, 2>> mu_r_ci95 = std::nullopt) {
-  const auto inside = [](double mu, std::array<double, 2> ci) {
-    return mu >= ci[0] && mu <= ci[1];
-  };
+// ln mu_r jointly) where one is `compatible` with it (inside its 95 % interval or region),
+// as the data cannot tell it from the fit and it costs no simulation more (a staged
+// design's refined packings usually are); else `at_fit`, run for the comparison. Never a
+// run that pours the experiment's own grains: it would compare the experiment with itself.
+FrictionRunSpec compared_run(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+                             const FrictionRunSpec& at_fit,
+                             const std::function<bool(const FrictionRunSpec&)>& compatible) {
   const auto distance = [&](const FrictionRunSpec& r) {
     const double ds = std::log(r.mu_s / at_fit.mu_s);
-    const double dr = mu_r_ci95 ? std::log(r.mu_r / at_fit.mu_r) : 0.0;
+    const double dr = at_fit.mu_r > 0 ? std::log(r.mu_r / at_fit.mu_r) : 0.0;
     return ds * ds + dr * dr;
   };
   const FrictionRunSpec* nearest = nullptr;
   for (const FrictionRunSpec& r : specs) {
-    if (!inside(r.mu_s, mu_s_ci95) || (mu_r_ci95 && !inside(r.mu_r, *mu_r_ci95))) continue;
+    if (!compatible(r) || twin.pours_experiments_grains(r.seed)) continue;
     if (!nearest || distance(r) < distance(*nearest)) nearest = &r;
   }
   return nearest ? *nearest : at_fit;
@@ -659,8 +679,8 @@ std::string compared_run_line(const FrictionRunSpec& compared, const FrictionRun
   std::string line =
       "compared at the twin's run nearest the fit, mu_s " + number_text(compared.mu_s);
   if (compared.mu_r >= 0) line += ", mu_r " + number_text(compared.mu_r);
-  return line + " (seed " + std::to_string(compared.seed) +
-         "), inside the 95% interval: no simulation more\n";
+  return line + " (seed " + std::to_string(compared.seed) + "), inside the 95% " +
+         (compared.mu_r >= 0 ? "region" : "interval") + ": no simulation more\n";
 }
 
 // "12 simulations", and where the comparison took one more at the fit, says so: the fit's
@@ -1079,8 +1099,10 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   const SteadyState measured = twin.measured_steady_state();
   ScanNoise noise;
   const ObservableFit fit = steady_state_fit(twin, runs, &noise);
-  const FrictionRunSpec best =
-      compared_run(specs, {three_digits(fit.mu_s), twin.seed()}, fit.mu_s_ci95);
+  const FrictionRunSpec best = compared_run(
+      twin, specs, {three_digits(fit.mu_s), twin.seed()}, [&](const FrictionRunSpec& r) {
+        return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];
+      });
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
   if (!o.fit_only) report << compared_run_line(best, {three_digits(fit.mu_s), twin.seed()});
@@ -1088,6 +1110,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   s.mu_s = fit.mu_s;
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
   s.simulations = simulations_with(twin, specs, best);
+  s.simulations_fitted = specs.size();
   const SteadyStateOutputs written =
       write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s, twin.observe.window);
   s.written.insert(s.written.end(), written.written.begin(), written.written.end());
@@ -1145,7 +1168,13 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   ScanNoise noise;
   const JointObservableFit fit = joint_steady_state_fit(twin, runs, &noise);
   const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
-  const FrictionRunSpec best = compared_run(specs, at_fit, fit.mu_s_ci95, fit.mu_r_ci95);
+  // Inside the joint 95 % region: (ln mu_s, ln mu_r) within chi2(2 dof) = 5.99 of the fit.
+  const Eigen::Matrix2d covariance = Eigen::Map<const Eigen::Matrix2d>(fit.log_covariance.data());
+  const Eigen::Matrix2d precision = covariance.inverse();
+  const FrictionRunSpec best = compared_run(twin, specs, at_fit, [&](const FrictionRunSpec& r) {
+    const Eigen::Vector2d d(std::log(r.mu_s / fit.mu_s), std::log(r.mu_r / fit.mu_r));
+    return d.dot(precision * d) <= 5.991;
+  });
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
   if (!o.fit_only) report << compared_run_line(best, at_fit);
@@ -1156,6 +1185,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   s.mu_r_ci95 = {fit.mu_r_ci95[0], fit.mu_r_ci95[1]};
   s.correlation = fit.correlation;
   s.simulations = simulations_with(twin, specs, best);
+  s.simulations_fitted = specs.size();
   std::vector<double> run_s, run_r;
   for (const FrictionRunSpec& r : specs) {
     run_s.push_back(r.mu_s);
@@ -1279,6 +1309,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
   s.mu_s = fit.mu_s;
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
   s.simulations = simulations_with(twin, specs, best);
+  s.simulations_fitted = specs.size();
   write_displacement_tables(o.out, fit, specs, runs, best, at_fit);
   s.written.push_back(o.out / "cdf_summaries.csv");
   s.written.push_back(o.out / "runs.csv");
@@ -1389,6 +1420,15 @@ void CalibrateOptions::validate() const {
   if (joint() && !steady) {
     throw Error("--fit mu_s,mu_r: the joint fit is on --observables steady-state");
   }
+  // What only the displacements' fit reads, refused rather than ignored under the default.
+  if (steady && per_cycle) {
+    throw Error("--summaries per-cycle: only with --observables displacements");
+  }
+  if (steady && noise != "auto") {
+    throw Error("--noise " + noise +
+                ": only with --observables displacements (the steady state takes a scan's "
+                "errors from its store and its contacts)");
+  }
   if (joint() && mu_r.size() < 3) throw Error("--mu-r: the joint fit needs at least 3 values");
   if (replicas < 1) throw Error("--replicas: at least one packing");
   // Replicas of a placed packing differ by their jitter alone: none, and they are one run.
@@ -1451,8 +1491,10 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   const bool steady = options.observables == CalibrationObservables::steady_state;
   if (steady) check_only(options, twin.measured_steady_state());
   std::string noise_model;
-  const FrictionFitOptions fit_options = displacement_fit_options(
-      options, experiment.header(), twin.errors, twin.observe.diameter, &noise_model);
+  const FrictionFitOptions fit_options =
+      steady ? FrictionFitOptions{}
+             : displacement_fit_options(options, experiment.header(), twin.errors,
+                                        twin.observe.diameter, &noise_model);
   fs::create_directories(options.out / "runs");
   twin.announce();
   twin.prepare_shared_packings();

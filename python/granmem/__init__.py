@@ -336,7 +336,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
-    every run (``None``: 0, or the design's own where ``mu_s`` and ``replicas`` are left: 3, placed 4). ``axis_noise``
+    every run (``None``: 0, but for a steady-state fit of mu_s whose ``mu_s`` and ``replicas``
+    are left to it 3, placed 4). ``axis_noise``
     (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
     the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
@@ -360,7 +361,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     after the runs under way and is raised. Returns a dict: mu_s, mu_s_ci95 (and mu_r,
     mu_r_ci95, correlation for a joint fit), true_mu_s / true_mu_r (a pseudo-experiment's,
     else NaN; ``true_mu_s``, ``true_mu_r``: a pseudo-experiment's whose store does not say
-    them, scans drawn from a simulation, for the report and the figures), simulations,
+    them, scans drawn from a simulation, for the report and the figures), simulations
+    (the one more at the fit for the comparison included), simulations_fitted,
     notes, written, report (the command line's lines)."""
     only = [only] if isinstance(only, str) else list(only)
     return _granmem.calibrate(os.fspath(experiment), os.fspath(out), _frictions(mu_s),

@@ -812,6 +812,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   d["true_mu_s"] = s.true_mu_s;
   d["true_mu_r"] = s.true_mu_r;
   d["simulations"] = s.simulations;
+  d["simulations_fitted"] = s.simulations_fitted;
   d["notes"] = s.notes;
   std::vector<std::string> written;
   for (const auto& p : s.written)

@@ -87,6 +87,16 @@ TEST_F(Calibrate, RefusesBadInput) {
                        {"--noise", "voxel size"});
   expect_clean_failure(calibrate({"--fit-only", "--observables", "displacements"}),
                        {"--fit-only", "steady-state"});
+  // What only the displacements' fit reads is refused under the default, not ignored.
+  expect_clean_failure(calibrate({"--summaries", "per-cycle"}),
+                       {"--summaries per-cycle", "--observables displacements"});
+  expect_clean_failure(calibrate({"--noise", "0.05"}),
+                       {"--noise 0.05", "--observables displacements"});
+  // A config's [simulate] is the caller's: checked against the store, not replaced by it.
+  write_text(in_work("grains.toml"), "[simulate]\ngrains = \"50\"\n");
+  std::vector<std::string> configured = calibrate({}, {});
+  configured.insert(configured.begin(), {"--config", "grains.toml"});
+  expect_clean_failure(configured, {"exp.h5", "--grains 60", "the twin has 50"});
   expect_clean_failure(calibrate({"--window", "auto", "--observables", "displacements"}),
                        {"--window auto", "steady-state"});
   expect_clean_failure(

@@ -122,10 +122,10 @@ struct CalibrateOptions {
   bool joint() const { return !mu_r.empty(); }
   // These options with the twin's design where they leave it, the one docs/CALIBRATION.md
   // measures for each fit: for the steady state 3 packings x mu_s 0.05, 0.14, 0.4 and 3
-  // packings more at that fit (refine, 12 runs), placed (TwinPreparation::experiment, as resolved_preparation() gives it) 2 x
-  // 0.05, 0.13, 0.35, 0.6 and 4 packings more at that fit (refine, 12 runs reaching past
-  // 0.4), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r), for the displacements
-  // 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
+  // packings more at that fit (refine, 12 runs), placed (TwinPreparation::experiment, as
+  // resolved_preparation() gives it) 2 x 0.05, 0.13, 0.35, 0.6 and 4 packings more at that fit
+  // (refine, 12 runs reaching past 0.4), for the joint fit 2 x mu_s 0.05, 0.12, 0.3 (x each mu_r),
+  // for the displacements 2 x 0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5.
   CalibrateOptions with_default_design() const;
   // --window's text: FIRST:LAST, or auto (`option` names it in an error).
   void set_window(const std::string& text, const std::string& option);
@@ -151,8 +151,9 @@ struct CalibrateSummary {
   double correlation = 0;  // of ln mu_s and ln mu_r in the joint fit
   // The experiment's frictions where granmem simulated it (a pseudo-experiment), else NaN.
   double true_mu_s = 0, true_mu_r = 0;
-  std::size_t simulations = 0;     // the twin's runs, the one at the fit included
-  std::vector<std::string> notes;  // the comparison's remarks at the fit
+  std::size_t simulations = 0;         // the twin's runs, the one at the fit included
+  std::size_t simulations_fitted = 0;  // the runs the fit is made from
+  std::vector<std::string> notes;      // the comparison's remarks at the fit
   std::vector<std::filesystem::path> written;
   // What the command line prints: the comparison at the fit, the fit and its interval.
   std::string Report() const { return report_; }

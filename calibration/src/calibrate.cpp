@@ -77,13 +77,34 @@ bool same_packing_settings(const RunSettings& a, const RunSettings& b) {
   return true;
 }
 
+// A `simulate` setting a pseudo-experiment's store says it was made with; null where none.
+const std::string* stored_setting(const RunHeader& experiment, const std::string& key) {
+  const auto it = experiment.parameters.find("simulate/" + key);
+  return it == experiment.parameters.end() ? nullptr : &it->second;
+}
+
+// The protocol settings the twin takes from a pseudo-experiment's store: those the caller
+// left (not in twin_given, and at simulate's default for a library caller), as the store
+// says them.
+RunSettings protocol_left_to_experiment(const CalibrateOptions& given,
+                                        const RunHeader& experiment) {
+  const RunSettings defaults = default_simulate_settings();
+  RunSettings taken;
+  for (const char* key : kProtocolSettings) {
+    const std::string* stored = stored_setting(experiment, key);
+    const bool set = given.twin_given.count(key) || given.twin.at(key) != defaults.at(key);
+    if (stored && !set) taken[key] = *stored;
+  }
+  return taken;
+}
+
 // The protocol a pseudo-experiment's store says must agree with the twin's.
 void check_against_experiment(const RunHeader& experiment, const std::string& file,
                               const RunSettings& twin, double box) {
   for (const char* key : kProtocolSettings) {
-    const auto it = experiment.parameters.find(std::string("simulate/") + key);
-    if (it != experiment.parameters.end() && it->second != twin.at(key)) {
-      throw Error(file + ": the experiment was simulated with --" + key + " " + it->second +
+    const std::string* stored = stored_setting(experiment, key);
+    if (stored && *stored != twin.at(key)) {
+      throw Error(file + ": the experiment was simulated with --" + key + " " + *stored +
                   ", the twin has " + twin.at(key) + " (set it in the config's [simulate])");
     }
   }
@@ -142,13 +163,8 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
 CalibrateOptions resolved_options(const CalibrateOptions& given,
                                   const TrajectoryReader& experiment) {
   CalibrateOptions options = given;
-  const RunSettings defaults = default_simulate_settings();
-  for (const char* key : kProtocolSettings) {
-    const auto it = experiment.header().parameters.find(std::string("simulate/") + key);
-    // Set by the caller: in twin_given, or away from simulate's default (a library caller's).
-    const bool set = given.twin_given.count(key) || given.twin.at(key) != defaults.at(key);
-    if (it != experiment.header().parameters.end() && !set) options.twin[key] = it->second;
-  }
+  for (const auto& [key, value] : protocol_left_to_experiment(given, experiment.header()))
+    options.twin[key] = value;
   options.preparation = resolved_preparation(given, experiment);
   return options.with_default_design();
 }
@@ -158,10 +174,10 @@ namespace {
 // The experiment's friction (mu-s, mu-r) where granmem simulated it (a pseudo-experiment),
 // else NaN.
 double true_friction(const RunHeader& experiment, const std::string& key) {
-  const auto it = experiment.parameters.find("simulate/" + key);
-  if (it == experiment.parameters.end()) return std::nan("");
+  const std::string* stored = stored_setting(experiment, key);
+  if (!stored) return std::nan("");
   try {
-    return std::stod(it->second);
+    return std::stod(*stored);
   } catch (const std::exception&) {
     return std::nan("");
   }
@@ -378,22 +394,21 @@ class Twin {
 
   // The protocol settings taken from a pseudo-experiment's store (resolved_options()), where
   // they are not simulate's defaults: what the twin was not told and did not guess.
-  void note_protocol_taken() const {
+  void note_protocol_taken(const RunSettings& taken) const {
     const RunSettings defaults = default_simulate_settings();
-    std::string taken;
-    for (const char* key : kProtocolSettings) {
-      const auto it = experiment_.header().parameters.find(std::string("simulate/") + key);
-      if (it == experiment_.header().parameters.end() || o_.twin_given.count(key) ||
-          it->second == defaults.at(key))
-        continue;
-      taken += std::string(taken.empty() ? "" : ", ") + "--" + key + " " + it->second;
+    std::string line;
+    for (const char* key : kProtocolSettings) {  // in the protocol's order
+      const auto it = taken.find(key);
+      if (it != taken.end() && it->second != defaults.at(key))
+        line += (line.empty() ? "--" : ", --") + it->first + " " + it->second;
     }
-    if (!taken.empty()) say("the twin's protocol from the experiment's store: " + taken);
+    if (!line.empty()) say("the twin's protocol from the experiment's store: " + line);
   }
 
-  void announce() const {
+  // `taken`: the protocol settings read from the experiment's store, said where not defaults.
+  void announce(const RunSettings& taken) const {
     note_experiment_seed();
-    note_protocol_taken();
+    note_protocol_taken(taken);
     note_located_grains();
     std::ostringstream line;
     std::string mu;
@@ -609,12 +624,10 @@ class Twin {
   // Whether the twin's packings of this seed pour the experiment's own grains (a
   // pseudo-experiment poured with it). A placed twin's seeds draw jitters, not pours.
   bool pours_experiments_grains(std::uint64_t seed) const {
-    const auto stored = experiment_.header().parameters.find("simulate/seed");
-    if (stored == experiment_.header().parameters.end() ||
-        o_.preparation == TwinPreparation::experiment)
-      return false;
+    const std::string* stored = stored_setting(experiment_.header(), "seed");
+    if (!stored || o_.preparation == TwinPreparation::experiment) return false;
     try {
-      return std::stoull(stored->second) == seed;
+      return std::stoull(*stored) == seed;
     } catch (const std::exception&) {
       return false;
     }
@@ -685,9 +698,9 @@ std::string compared_run_line(const FrictionRunSpec& compared, const FrictionRun
 
 // "12 simulations", and where the comparison took one more at the fit, says so: the fit's
 // own runs are the design's.
-std::string simulations_text(std::size_t fitted, std::size_t simulated) {
-  std::string text = std::to_string(fitted) + " simulations";
-  if (simulated > fitted) text += ", 1 more at the fit for the comparison";
+std::string simulations_text(const CalibrateSummary& s) {
+  std::string text = std::to_string(s.simulations_fitted) + " simulations";
+  if (s.simulations > s.simulations_fitted) text += ", 1 more at the fit for the comparison";
   return text;
 }
 
@@ -1099,13 +1112,13 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   const SteadyState measured = twin.measured_steady_state();
   ScanNoise noise;
   const ObservableFit fit = steady_state_fit(twin, runs, &noise);
-  const FrictionRunSpec best = compared_run(
-      twin, specs, {three_digits(fit.mu_s), twin.seed()}, [&](const FrictionRunSpec& r) {
-        return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];
-      });
+  const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed()};
+  const FrictionRunSpec best = compared_run(twin, specs, at_fit, [&](const FrictionRunSpec& r) {
+    return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];
+  });
   const Comparison compared = compare_at_fit(twin, best, Eigen::Vector3d::Zero(), 0);
   if (!mpi_ranks().root()) return;
-  if (!o.fit_only) report << compared_run_line(best, {three_digits(fit.mu_s), twin.seed()});
+  if (!o.fit_only) report << compared_run_line(best, at_fit);
   add_comparison(s, report, compared);
   s.mu_s = fit.mu_s;
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
@@ -1125,7 +1138,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["chi2"] = fit.chi2;
   j["dof"] = fit.dof;
   j["n_simulations"] = s.simulations;
-  j["n_simulations_fitted"] = specs.size();
+  j["n_simulations_fitted"] = s.simulations_fitted;
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["axis_noise_deg"] = twin.observe.axis_noise * 180 / M_PI;
@@ -1147,8 +1160,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
-         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(specs.size(), s.simulations)
-         << ")";
+         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(s) << ")";
   if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
   report << "\n" << observables_line(twin, fit.names, &fit.resolution);
   report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
@@ -1213,7 +1225,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   j["dof"] = fit.dof;
   j["region95"] = fit.region95;
   j["n_simulations"] = s.simulations;
-  j["n_simulations_fitted"] = specs.size();
+  j["n_simulations_fitted"] = s.simulations_fitted;
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["observables"] = fit.names;
@@ -1229,7 +1241,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
          << fit.mu_r_ci95[1] << ")";
   if (std::isfinite(s.true_mu_r)) report << "  true " << s.true_mu_r;
   report << "\n  correlation of ln mu_s and ln mu_r " << fit.correlation << ", "
-         << simulations_text(specs.size(), s.simulations) << "\n"
+         << simulations_text(s) << "\n"
          << observables_line(twin, fit.names, nullptr) << "  chi2 " << fit.chi2 << " for "
          << fit.dof << " dof; cross-validated " << fit.cross_validated_sigma[0] << " (mu_s), "
          << fit.cross_validated_sigma[1] << " (mu_r) in ln at the fit from "
@@ -1334,7 +1346,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
   j["mu_s_ci95"] = s.mu_s_ci95;
   j["mu_s_interval_method"] = fit.method;
   j["n_simulations"] = s.simulations;
-  j["n_simulations_fitted"] = specs.size();
+  j["n_simulations_fitted"] = s.simulations_fitted;
   j["replicas"] = o.replicas;
   j["deposit"] = preparation_name(o.preparation);
   j["summaries"] = o.per_cycle ? "per-cycle" : "pooled";
@@ -1356,7 +1368,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
 
   const std::vector<double> mu = sorted(o.mu_s);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
-         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(specs.size(), s.simulations)
+         << " - " << fit.mu_s_ci95[1] << ", " << simulations_text(s)
          << (fit.converged ? "" : ", fit NOT converged") << ")\n"
          << "  at the fit: KS " << ks << ", Wasserstein-1 " << w1 << " d (end-of-cycle dr); chi2 "
          << fit.chi2 << " for " << fit.dof << " dof; realization scatter x" << fit.overdispersion
@@ -1496,7 +1508,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
              : displacement_fit_options(options, experiment.header(), twin.errors,
                                         twin.observe.diameter, &noise_model);
   fs::create_directories(options.out / "runs");
-  twin.announce();
+  twin.announce(protocol_left_to_experiment(given, experiment.header()));
   twin.prepare_shared_packings();
   std::vector<FrictionRunSpec> specs = twin.design();
   twin.run(specs);

@@ -36,7 +36,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
     int threads = 0, degree = 2, replicas = 0, refine = -1;
-    std::string axis_noise = "auto", placed_jitter = "auto";
+    std::string axis_noise = "auto", placed_jitter = "auto", placed_cycle = "auto";
     std::string true_mu_s, true_mu_r;
   };
   auto args = std::make_shared<Args>();
@@ -94,10 +94,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "each: every run pours its seed's grains and deposits them at its own mu_s "
                   "(as the experiment was prepared); shared: one packing per seed deposited at "
                   "the twin's --mu-s, its friction switched before the drive; experiment: "
-                  "every run starts from the experiment's own packing, its first frame's "
-                  "grains moved by --placed-jitter and settled at the run's mu_s; auto: "
-                  "experiment for a steady-state fit of mu_s on a simulation's packing (its "
-                  "first frame exact: cycle 0, every grain), else each")
+                  "every run starts from the experiment's own packing, the grains of its frame "
+                  "before the window (--placed-cycle) moved by --placed-jitter and settled at "
+                  "the run's mu_s; auto: experiment for a steady-state fit of mu_s on a "
+                  "simulation's packing (that frame exact: every grain), else each")
       ->capture_default_str()
       ->check(CLI::IsMember({"each", "shared", "experiment", "auto"}));
   cmd->add_option("--true-mu-s", args->true_mu_s,
@@ -108,6 +108,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "--deposit experiment: each replica's grains moved from the experiment's by a "
                   "normal draw of this RMS a coordinate (a length); auto: 1e-4 grain "
                   "diameters")
+      ->capture_default_str();
+  cmd->add_option("--placed-cycle", args->placed_cycle,
+                  "--deposit experiment: the experiment's cycle whose frame the twin's packings "
+                  "are placed from, its runs driven from the next cycle on (0: the packing "
+                  "before the first cycle); auto: the cycle before the window")
       ->capture_default_str();
   cmd->add_option("--summaries", args->summaries,
                   "pooled: the CDF of the window's pooled displacements (the paper's steady "
@@ -185,6 +190,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     if (args->refine >= 0) o.refine = args->refine;
     o.preparation = preparation_named(args->preparation);
     o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
+    o.placed_cycle = parse_placed_cycle(args->placed_cycle, "--placed-cycle");
     o.fit_only = args->fit_only;
     if (!args->true_mu_s.empty()) o.true_mu_s = one_friction(args->true_mu_s, "--true-mu-s");
     if (!args->true_mu_r.empty()) o.true_mu_r = one_friction(args->true_mu_r, "--true-mu-r");

@@ -142,13 +142,26 @@ TwinPreparation preparation_named(const std::string& name, const std::string& op
   throw Error(option + " '" + name + "': expected each, shared, experiment or auto");
 }
 
-bool exact_first_packing(const TrajectoryReader& run) {
+bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle) {
   const RunHeader& h = run.header();
-  if (!h.has_orientation || h.has_position_error || run.frame_count() == 0 ||
-      run.steps().front() != 0) {
-    return false;
-  }
-  return run.read_frame(0).position.allFinite();
+  if (!h.has_orientation || h.has_position_error) return false;
+  const auto& steps = run.steps();
+  const auto at = std::find(steps.begin(), steps.end(), cycle);
+  return at != steps.end() && run.read_frame(std::size_t(at - steps.begin())).position.allFinite();
+}
+
+std::pair<std::int64_t, std::int64_t> compared_window(const CalibrateOptions& options,
+                                                      const TrajectoryReader& experiment) {
+  if (options.window) return *options.window;
+  const auto& steps = experiment.steps();
+  if (steps.empty()) throw Error(options.experiment.string() + ": no frames");
+  return {std::max(steps.front() + 1, steps.back() - 9), steps.back()};
+}
+
+std::int64_t placed_cycle_for(const CalibrateOptions& options, const TrajectoryReader& experiment) {
+  if (options.placed_cycle) return *options.placed_cycle;
+  if (options.auto_window) return experiment.steps().empty() ? 0 : experiment.steps().front();
+  return compared_window(options, experiment).first - 1;
 }
 
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
@@ -156,8 +169,9 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
   if (options.preparation != TwinPreparation::automatic) return options.preparation;
   const bool measured =
       options.observables == CalibrationObservables::steady_state && !options.joint();
-  return measured && exact_first_packing(experiment) ? TwinPreparation::experiment
-                                                     : TwinPreparation::each;
+  return measured && exact_packing_at(experiment, placed_cycle_for(options, experiment))
+             ? TwinPreparation::experiment
+             : TwinPreparation::each;
 }
 
 CalibrateOptions resolved_options(const CalibrateOptions& given,
@@ -166,6 +180,15 @@ CalibrateOptions resolved_options(const CalibrateOptions& given,
   for (const auto& [key, value] : protocol_left_to_experiment(given, experiment.header()))
     options.twin[key] = value;
   options.preparation = resolved_preparation(given, experiment);
+  if (options.placed_cycle && options.preparation != TwinPreparation::experiment) {
+    const bool asked = given.preparation != TwinPreparation::automatic;
+    throw Error("--placed-cycle " + std::to_string(*options.placed_cycle) +
+                ": only for a twin placed from the experiment; this one is " +
+                (asked ? std::string("--deposit ") + preparation_name(given.preparation)
+                       : "poured (that frame of " + given.experiment.string() +
+                             " does not hold its packing exactly, or the fit is not mu_s's "
+                             "on the steady state); --deposit experiment places it"));
+  }
   return options.with_default_design();
 }
 
@@ -215,10 +238,7 @@ ObservableOptions observable_options(const CalibrateOptions& o, const Trajectory
   observe.motion.wall_distance = o.wall_distance;
   observe.rotations = h.has_axis || h.has_orientation;
   observe.axis_noise = twin_axis_noise(o, errors);
-  const auto& steps = experiment.steps();
-  observe.window = o.window ? *o.window
-                            : std::pair<std::int64_t, std::int64_t>{
-                                  std::max(steps.front() + 1, steps.back() - 9), steps.back()};
+  observe.window = compared_window(o, experiment);
   if (observe.window.first < 1) throw Error("--window: cycles start at 1");
   if (observe.motion.wall_distance > 0) {
     observe.motion.box = Box{Eigen::Vector3d::Zero(), Eigen::Vector3d(d.box_side, d.box_side, 1e9)};
@@ -376,6 +396,8 @@ class Twin {
   }
 
   const CalibrateOptions& options() const { return o_; }
+  // The cycle the twin's runs start after (a placed twin's; 0 for a prepared packing).
+  std::int64_t first_cycle() const { return placed_cycle_; }
   const TrajectoryReader& experiment() const { return experiment_; }
   // The seeds after the design's: packings none of its runs pour.
   std::uint64_t next_seed(int k) const { return seeds_.back() + 1 + std::uint64_t(k); }
@@ -416,10 +438,10 @@ class Twin {
       mu += (mu.empty() ? "" : ",") + number_text(m);
     line << "calibrate: twin of " << o_.experiment.string() << ": " << deposit_.grains
          << " grains, box " << deposit_.box_side * 100
-         << " cm, A = " << series_.protocol.drive.amplitude * 100 << " cm, cycles 1-"
-         << series_.protocol.cycles << " (window " << observe.window.first << ":"
-         << observe.window.second << "), mu_s " << mu << ", " << o_.replicas
-         << " packing(s) from seed " << deposit_.seed;
+         << " cm, A = " << series_.protocol.drive.amplitude * 100 << " cm, cycles "
+         << series_.protocol.first_cycle + 1 << "-" << series_.protocol.cycles << " (window "
+         << observe.window.first << ":" << observe.window.second << "), mu_s " << mu << ", "
+         << o_.replicas << " packing(s) from seed " << deposit_.seed;
     if (o_.refined_packings() > 0)
       line << ", then " << o_.refined_packings() << " more at their fit";
     line << ", " << preparation_text();
@@ -429,10 +451,12 @@ class Twin {
            << (o_.axis_noise ? "--axis-noise" : "the experiment's RMS axis standard error") << ")";
     }
     say(line.str());
-    if (o_.preparation == TwinPreparation::experiment && !exact_first_packing(experiment_)) {
-      say("note: the experiment's first frame does not hold its packing exactly (a scan's "
-          "centres carry their locating errors, and grains it missed are taken from later "
-          "frames): placed there, the twin's packings settle denser than the experiment's "
+    if (o_.preparation == TwinPreparation::experiment &&
+        !exact_packing_at(experiment_, placed_cycle_)) {
+      say("note: the experiment's frame of cycle " + std::to_string(placed_cycle_) +
+          " does not hold its packing exactly (a scan's centres carry their locating errors, "
+          "and grains it missed are taken from later frames): placed there, the twin's packings "
+          "settle denser than the experiment's "
           "was (centres off by 20 um: +0.0016 in packing fraction on 2,500 grains), so the "
           "fit leans to higher friction with too narrow an interval; --deposit each pours "
           "the twin's own");
@@ -452,8 +476,8 @@ class Twin {
       case TwinPreparation::shared:
         return "deposited once per seed";
       case TwinPreparation::experiment:
-        return "placed where the experiment's first frame has its " +
-               std::to_string(placed_->size()) + " grains, moved by " +
+        return "placed where the experiment's frame of cycle " + std::to_string(placed_cycle_) +
+               " has its " + std::to_string(placed_->size()) + " grains, moved by " +
                number_text(placed_jitter_ * 1e3) + " mm RMS a coordinate, settled at each friction";
       default:
         return "deposited at each friction";
@@ -498,15 +522,25 @@ class Twin {
     say(line.str());
   }
 
-  // --deposit experiment: the experiment's first frame, the packing before its first cycle,
-  // is where every run's grains start (each replica jittered by its seed).
+  // --deposit experiment: the experiment's frame of the placed cycle (by default the one
+  // before the window) is where every run's grains start (each replica jittered by its
+  // seed); the runs drive the cycles after it, numbered as the experiment's.
   void place_experiments_grains() {
-    if (experiment_.frame_count() == 0 || experiment_.steps().front() != 0) {
-      throw Error(o_.experiment.string() +
-                  ": --deposit experiment starts the twin from the packing before the first "
-                  "cycle, and the experiment's first frame is not cycle 0");
+    placed_cycle_ = placed_cycle_for(o_, experiment_);
+    const auto& steps = experiment_.steps();
+    const auto at = std::find(steps.begin(), steps.end(), placed_cycle_);
+    if (at == steps.end()) {
+      throw Error(o_.experiment.string() + ": --deposit experiment starts the twin from the " +
+                  "experiment's frame of cycle " + std::to_string(placed_cycle_) +
+                  (o_.placed_cycle ? " (--placed-cycle)" : " (the one before the window)") +
+                  ", and it has none");
     }
-    placed_ = grains_of_frame(experiment_, 0, deposit_, physics_);
+    if (placed_cycle_ >= observe.window.first) {
+      throw Error("--placed-cycle " + std::to_string(placed_cycle_) +
+                  ": the twin must start before the window's first cycle (" +
+                  std::to_string(observe.window.first) + ")");
+    }
+    placed_ = grains_of_frame(experiment_, std::size_t(at - steps.begin()), deposit_, physics_);
     placed_jitter_ = std::isfinite(o_.placed_jitter) ? o_.placed_jitter
                                                      : kPlacedJitterDiameters * 2 * deposit_.radius;
   }
@@ -603,6 +637,7 @@ class Twin {
     series.parallel = o_.parallel;
     series.stop = o_.stop;
     series.protocol.cycles = observe.window.second;
+    series.protocol.first_cycle = placed_cycle_;
     series.protocol.drive = drive_from(settings_, physics_, deposit_.box_side, deposit_.box_side,
                                        deposit_.lid_mass, deposit_.radius);
     // The twin's own settings only: what calibrate sets per run (cycles, mu_s) is written
@@ -615,6 +650,7 @@ class Twin {
     if (placed_) {  // runs placed from another experiment's packing are other runs
       series.protocol.parameters["calibrate/placed_from"] = placed_identity();
       series.protocol.parameters["calibrate/placed_jitter"] = number_text(placed_jitter_) + " m";
+      series.protocol.parameters["calibrate/placed_cycle"] = std::to_string(placed_cycle_);
     }
     series.protocol.validate(deposit_.box_side, physics_.dt);
     return series;
@@ -652,8 +688,9 @@ class Twin {
   FrictionSeriesOptions series_;
   std::vector<std::uint64_t> seeds_;
   std::map<std::uint64_t, Simulation> shared_;
-  std::optional<Grains> placed_;  // --deposit experiment: its first frame's grains
-  double placed_jitter_ = 0;      // m
+  std::optional<Grains> placed_;   // --deposit experiment: its frame's grains
+  double placed_jitter_ = 0;       // m
+  std::int64_t placed_cycle_ = 0;  // the experiment's cycle they were placed from
 };
 
 std::size_t simulations_with(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
@@ -720,6 +757,8 @@ Comparison compare_at_fit(const Twin& twin, const FrictionRunSpec& best,
 // The members every summary.json ends with.
 void add_protocol(JsonObject& j, const Twin& twin) {
   j["window"] = {twin.observe.window.first, twin.observe.window.second};
+  if (twin.options().preparation == TwinPreparation::experiment)
+    j["placed_cycle"] = twin.first_cycle();
   j["experiment"] = twin.options().experiment.string();
   j["settings"] = twin.settings();
 }
@@ -1447,6 +1486,7 @@ void CalibrateOptions::validate() const {
   if (!std::isnan(placed_jitter) && !(placed_jitter > 0 && std::isfinite(placed_jitter))) {
     throw Error("--placed-jitter: a length > 0 (replicas not moved would all be the same run)");
   }
+  if (placed_cycle && *placed_cycle < 0) throw Error("--placed-cycle: a cycle, 0 or later");
   if (degree < 1) throw Error("--degree: at least 1");
   // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
   const std::size_t needed = std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);
@@ -1529,6 +1569,22 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
 double parse_placed_jitter(const std::string& text, const std::string& option) {
   if (trim(text) == "auto") return std::nan("");
   return parse_si(text, Dimension::length, "m", option);
+}
+
+std::optional<std::int64_t> parse_placed_cycle(const std::string& text, const std::string& option) {
+  const std::string t(trim(text));
+  if (t == "auto") return std::nullopt;
+  std::size_t used = 0;
+  long long cycle = -1;
+  try {
+    cycle = std::stoll(t, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != t.size() || cycle < 0) {
+    throw Error(option + " '" + text + "': expected auto or a cycle, 0 or later");
+  }
+  return cycle;
 }
 
 std::optional<double> parse_axis_noise(const std::string& text, const std::string& option) {

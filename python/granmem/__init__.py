@@ -323,8 +323,9 @@ def _optional_float(value):
 def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="steady-state", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
-              refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto", fit_only=False,
-              true_mu_s=None, true_mu_r=None, parallel=0, progress=None, **twin):
+              refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto",
+              placed_cycle="auto", fit_only=False, true_mu_s=None, true_mu_r=None, parallel=0,
+              progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -344,10 +345,11 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     ``noise`` (displacements): "scans" takes the RMS of the scans' position standard errors
     ("auto" too where the store has them, else fits it on scans). ``deposit``: "each" (every
     run pours its own packing at its friction), "shared" (one per seed, its friction
-    switched) or "experiment" (every run starts from the experiment's first frame's grains,
-    each replica moved by ``placed_jitter``, a length; "auto": 1e-4 grain diameters) or "auto" (the default:
-    "experiment" for a steady-state fit of mu_s on a simulation's packing, whose first frame
-    holds it exactly, else "each").
+    switched) or "experiment" (every run starts from the grains of the experiment's frame of
+    cycle ``placed_cycle``, "auto": the one before the window, and drives the cycles after it;
+    each replica moved by ``placed_jitter``, a length; "auto": 1e-4 grain diameters) or "auto"
+    (the default: "experiment" for a steady-state fit of mu_s on a simulation's packing,
+    whose frame there holds it exactly, else "each").
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
     "steady-state" 0.05, 0.14, 0.4 on 3 packings, then 3 more at their fit (12 runs; a twin
@@ -373,5 +375,5 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
-                              bool(fit_only), _optional_float(true_mu_s),
+                              str(placed_cycle), bool(fit_only), _optional_float(true_mu_s),
                               _optional_float(true_mu_r), int(parallel), twin, progress)

@@ -210,4 +210,10 @@ def test_bad_calibrations_are_one_clear_error(tmp_path, experiment):
     with pytest.raises(granmem.Error, match="placed-jitter: a length > 0"):
         granmem.calibrate(experiment, tmp_path / "x", deposit="experiment", placed_jitter=0,
                           **FIT, **TWIN)
+    with pytest.raises(granmem.Error, match="placed_cycle 'first': expected auto or a cycle"):
+        granmem.calibrate(experiment, tmp_path / "x", deposit="experiment", placed_cycle="first",
+                          **FIT, **TWIN)
+    with pytest.raises(granmem.Error, match="placed-cycle 0: only for a twin placed from the experiment; this one is --deposit each"):
+        granmem.calibrate(experiment, tmp_path / "x", deposit="each", placed_cycle=0,
+                          **FIT, **TWIN)
     assert not (tmp_path / "x").exists()  # refused before any output

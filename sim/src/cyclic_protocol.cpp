@@ -215,9 +215,9 @@ class CycleRunner {
   // The prepared packing, before the first cycle: frame 0, its observables, and the state
   // kept if cycle 0 is asked for (the untrained packing, the read-out's reference).
   void start_fresh() {
-    state_.cycles_done = 0;
+    state_.cycles_done = o_.first_cycle;
     state_.step_in_cycle = 0;
-    append(kEnd, 0);
+    append(kEnd, o_.first_cycle);
     end_of_cycle_observables(driven_wall_force(sim_));
     keep_if_asked();
   }
@@ -363,6 +363,10 @@ class CycleRunner {
 
 void CyclicOptions::validate(double box_y, double dt) const {
   if (cycles < 1) throw Error("cycles: at least one cycle is needed");
+  if (first_cycle < 0 || first_cycle >= cycles) {
+    throw Error("first cycle " + std::to_string(first_cycle) + ": from 0 to the last cycle's " +
+                std::to_string(cycles - 1));
+  }
   // 0 keeps the wall still for the period: the read-out's reference of no drive.
   if (!(drive.amplitude >= 0)) throw Error("amplitude: must be zero or positive");
   if (drive.amplitude >= 0.5 * box_y) {

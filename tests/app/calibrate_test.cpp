@@ -152,11 +152,16 @@ TEST_F(Calibrate, FitsOnSteadyStateObservables) {
                         "cal/observable_fit.dat", "cal/steady_state_runs.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(in_work(f))) << f;
   }
-  // The window from the runs themselves (the same runs, reused): three cycles after the
-  // deposit are no steady state at this size, and it says so.
+  // The window from the runs themselves: three cycles after the deposit are no steady state
+  // at this size, and it says so. The runs it chooses from start before the first cycle
+  // (the window is not known before them), not after the given window's cycle 1.
   const RunResult chosen = granmem_ok(calibrate({"--window", "auto", "--mu-s", "0.05,0.1,0.2,0.4",
                                                  "--observables", "steady-state", "--fit-only"}));
-  EXPECT_NE(chosen.err.find("reusing 8 finished runs"), std::string::npos) << chosen.err;
+  EXPECT_NE(chosen.err.find("cycles 1-3 (window 1:3), mu_s 0.05,0.1,0.2,0.4"), std::string::npos)
+      << chosen.err;
+  EXPECT_NE(chosen.err.find("placed where the experiment's frame of cycle 0"), std::string::npos)
+      << chosen.err;
+  EXPECT_EQ(chosen.err.find("reusing"), std::string::npos) << chosen.err;
   EXPECT_NE(chosen.out.find("window from the twin's runs: cycles "), std::string::npos)
       << chosen.out;
   expect_fit_in_its_interval(read_text(in_work("cal/summary.json")));
@@ -293,32 +298,52 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
   EXPECT_TRUE(std::filesystem::exists(in_work("shared/packing_seed_4.checkpoint.h5")));
 }
 
-// --deposit experiment: every run starts from the experiment's own packing, its first
-// frame's grains jittered by the run's seed and settled at the run's friction: at the true
-// friction the twin starts where the experiment does, its pour's scatter gone. The default
-// (auto) does so for a simulation's packing, and pours for scans.
+// --deposit experiment: every run starts from the experiment's own packing, the grains of
+// its frame before the window jittered by the run's seed and settled at the run's friction,
+// and drives the cycles after it: at the true friction the twin starts where the experiment
+// stands, its pour's scatter gone. The default (auto) does so for a simulation's packing,
+// and pours for scans.
 TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   const std::vector<std::string> design{"--window",      "2:3",          "--mu-s",    "0.1,0.2,0.4",
                                         "--observables", "steady-state", "--fit-only"};
   const RunResult r = granmem_ok(calibrate(design));
-  EXPECT_NE(r.err.find("placed where the experiment's first frame has its 60 grains, moved by "
-                       "0.0005 mm RMS"),
+  EXPECT_NE(r.err.find("cycles 2-3 (window 2:3)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("placed where the experiment's frame of cycle 1 has its 60 grains, moved "
+                       "by 0.0005 mm RMS"),
             std::string::npos)
       << r.err;
   const std::string json = read_text(in_work("cal/summary.json"));
   EXPECT_NE(json.find("\"deposit\": \"experiment\""), std::string::npos) << json;
+  EXPECT_EQ(json_value(json, "placed_cycle"), 1) << json;
   expect_fit_in_its_interval(json);
-  // Before the first cycle, the packing's height: the twin's placed packings at the true
-  // friction against the experiment's, and poured packings against it.
+  // Where the runs start, the packing's height: the twin's placed packings at the true
+  // friction against the experiment's there (after cycle 1, numbered so), and poured
+  // packings against the experiment's before its first cycle.
   const double d = 0.005;
-  auto start_height = [](const std::string& file) {
-    return TrajectoryReader(file).observables().at("lid_height").value.front();
+  auto height_at = [](const std::string& file, std::int64_t cycle) {
+    const Observable lid = TrajectoryReader(file).observables().at("lid_height");
+    const auto at = std::find(lid.step.begin(), lid.step.end(), cycle);
+    return at == lid.step.end() ? std::nan("") : lid.value[std::size_t(at - lid.step.begin())];
   };
-  const double experiment = start_height(in_work("exp.h5"));
   for (const char* seed : {"1", "2"}) {
     const std::string run = in_work(std::string("cal/runs/mu_s_0.2_seed_") + seed + ".h5");
-    EXPECT_NEAR(start_height(run), experiment, 0.01 * d) << run;
+    EXPECT_EQ(TrajectoryReader(run).steps().front(), 1) << run;
+    EXPECT_NEAR(height_at(run, 1), height_at(in_work("exp.h5"), 1), 0.01 * d) << run;
   }
+  // From the packing before the first cycle (--placed-cycle 0): the runs drive cycles 1-3,
+  // other runs than those placed after cycle 1.
+  std::vector<std::string> from_start = calibrate(design);
+  from_start[4] = "start";
+  from_start.insert(from_start.end(), {"--placed-cycle", "0"});
+  const RunResult started = granmem_ok(from_start);
+  EXPECT_NE(started.err.find("cycles 1-3 (window 2:3)"), std::string::npos) << started.err;
+  const std::string started_run = in_work("start/runs/mu_s_0.2_seed_1.h5");
+  EXPECT_EQ(TrajectoryReader(started_run).steps().front(), 0);
+  EXPECT_NEAR(height_at(started_run, 0), height_at(in_work("exp.h5"), 0), 0.01 * d);
+  from_start.back() = "2";
+  expect_clean_failure(from_start, {"--placed-cycle 2", "before the window"});
+  from_start.back() = "first";
+  expect_clean_failure(from_start, {"--placed-cycle 'first'", "a cycle, 0 or later"});
   // Placed runs are reused only for the same packing placed the same way.
   std::vector<std::string> again = design;
   EXPECT_NE(granmem_ok(calibrate(again)).err.find("reusing 6 finished runs"), std::string::npos);
@@ -367,7 +392,7 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   double off = 0;
   for (const char* seed : {"1", "2"}) {
     const std::string run = in_work(std::string("cal/runs/mu_s_0.2_seed_") + seed + ".h5");
-    off = std::max(off, std::abs(start_height(run) - experiment));
+    off = std::max(off, std::abs(height_at(run, 0) - height_at(in_work("exp.h5"), 0)));
   }
   EXPECT_GT(off, 0.05 * d);
   // Scans' centres carry their errors: the default pours, and placing is said to lean.
@@ -379,17 +404,23 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   std::vector<std::string> from_scans = calibrate(design);
   from_scans[2] = "scans.h5";
   EXPECT_NE(granmem_ok(from_scans).err.find("deposited at each friction"), std::string::npos);
+  std::vector<std::string> scans_from = from_scans;
+  scans_from.insert(scans_from.end(), {"--placed-cycle", "1"});
+  expect_clean_failure(scans_from, {"--placed-cycle 1", "this one is poured"});
   from_scans.insert(from_scans.end(), {"--deposit", "experiment"});
   EXPECT_NE(granmem_ok(from_scans).err.find("fit leans to higher friction"), std::string::npos);
-  // The packing before the first cycle is what the twin starts from.
+  // A store whose first frame is after cycle 1, not the packing before the first cycle: the
+  // default places it (it precedes the window); placed from cycle 0, refused.
   Trajectories later = read_trajectories(in_work("exp.h5"));
   later.frames.erase(later.frames.begin());
   write_trajectories(in_work("later.h5"), later);
   std::vector<std::string> from_later = calibrate(design);
   from_later[2] = "later.h5";
-  EXPECT_NE(granmem_ok(from_later).err.find("deposited at each friction"), std::string::npos);
-  from_later.insert(from_later.end(), {"--deposit", "experiment"});
-  expect_clean_failure(from_later, {"later.h5", "--deposit experiment", "not cycle 0"});
+  EXPECT_NE(granmem_ok(from_later).err.find("placed where the experiment's frame of cycle 1"),
+            std::string::npos);
+  from_later.insert(from_later.end(), {"--deposit", "experiment", "--placed-cycle", "0"});
+  expect_clean_failure(from_later, {"later.h5", "--deposit experiment", "frame of cycle 0",
+                                    "(--placed-cycle)", "has none"});
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {

@@ -189,6 +189,38 @@ TEST_F(Restart, AKeptStateStartsTheRestOfTheRunBitForBit) {
   expect_same_state(whole, from_1);
 }
 
+// A packing started as after cycle 4 (a twin placed where an experiment's frame of cycle 4
+// has its grains) runs the same cycles as one started at 0, numbered 4 to 7: its frames'
+// and observables' steps are the others' plus 4, all else bit for bit.
+TEST_F(Restart, ARunNumberedFromALaterCycleIsTheSameRun) {
+  Simulation whole = small_packing();
+  const CyclicOptions a = whole_run(&whole);
+
+  fs::create_directories(path("later"));
+  CyclicOptions b = cycles_into(path("later"), 7);
+  b.first_cycle = 4;
+  Simulation sim = small_packing();
+  ProtocolState state;
+  EXPECT_EQ(run_cycles(sim, b, state).cycles_done, 7);
+  expect_same_state(whole, sim);
+  const Trajectories ta = read_trajectories(a.out), tb = read_trajectories(b.out);
+  ASSERT_EQ(tb.frames.size(), ta.frames.size());
+  for (std::size_t t = 0; t < ta.frames.size(); ++t) {
+    EXPECT_EQ(tb.frames[t].step, ta.frames[t].step + 4);
+    EXPECT_TRUE(same_array(ta.frames[t].position.data(), tb.frames[t].position.data(),
+                           std::size_t(ta.frames[t].position.size()), "position"));
+  }
+  for (const auto& [name, oa] : ta.observables) {
+    const Observable& ob = tb.observables.at(name);
+    ASSERT_EQ(ob.step.size(), oa.step.size()) << name;
+    for (std::size_t k = 0; k < oa.step.size(); ++k)
+      EXPECT_EQ(ob.step[k], oa.step[k] + 4) << name;
+    EXPECT_TRUE(same_array(oa.value.data(), ob.value.data(), oa.value.size(), name));
+  }
+  b.first_cycle = 7;  // no cycle left to run
+  EXPECT_THROW(b.validate(0.02, 25e-6), Error);
+}
+
 TEST(KeptStates, NegativeCyclesAreRefused) {
   CyclicOptions o;
   o.drive.amplitude = 1e-3;

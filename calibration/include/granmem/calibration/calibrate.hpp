@@ -29,10 +29,11 @@ enum class CalibrationObservables { displacements, steady_state };
 // How the twin's packings are made: each run deposits its own grains at its friction (as
 // the experiment was prepared), or one packing per seed is deposited once (kept in the
 // output folder) and its friction switched before the drive, or each run starts from the
-// experiment's own packing, its first frame's grains (placed_packing.hpp) jittered by the
-// run's seed and settled at the run's friction. Automatic: the experiment's own packing
-// where its first frame holds it exactly (exact_first_packing()) and the fit is mu_s's on
-// the steady state, where it was measured (docs/CALIBRATION.md); else each its own.
+// experiment's own packing, the grains of its frame before the window (placed_packing.hpp;
+// CalibrateOptions::placed_cycle) jittered by the run's seed and settled at the run's
+// friction. Automatic: the experiment's own packing where that frame holds it exactly
+// (exact_packing_at()) and the fit is mu_s's on the steady state, where it was measured
+// (docs/CALIBRATION.md); else each its own.
 enum class TwinPreparation { each, shared, experiment, automatic };
 // The settings that make the protocol: a pseudo-experiment simulated by granmem says what
 // it used, the twin takes them where its caller did not set them, and they must agree.
@@ -49,11 +50,11 @@ inline constexpr double kPlacedJitterDiameters = 1e-4;
 const char* preparation_name(TwinPreparation preparation);
 // Its name read back (each, shared, experiment, auto); Error naming `option` otherwise.
 TwinPreparation preparation_named(const std::string& name, const std::string& option = "--deposit");
-// Whether a run's first frame holds its packing before the first cycle exactly: a
-// simulation's (orientations, no positions' standard errors) at cycle 0 with every grain.
-// A scan's carries its locating errors, and a packing placed from it settles denser (a
-// 2,500-grain packing placed with 20 um errors, 0.0016 in packing fraction).
-bool exact_first_packing(const TrajectoryReader& run);
+// Whether the run has a frame of `cycle` that holds its packing exactly: a simulation's
+// (orientations, no positions' standard errors) with every grain. A scan's carries its
+// locating errors, and a packing placed from it settles denser (a 2,500-grain packing
+// placed with 20 um errors, 0.0016 in packing fraction).
+bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle);
 
 struct CalibrateOptions {
   std::filesystem::path experiment;  // the experiment's trajectory store
@@ -98,6 +99,10 @@ struct CalibrateOptions {
   // m: TwinPreparation::experiment: each replica's grains moved from the experiment's by a
   // normal draw of this RMS per coordinate; NaN: kPlacedJitterDiameters grain diameters.
   double placed_jitter = std::nan("");
+  // TwinPreparation::experiment: the experiment's cycle whose frame the twin's packings are
+  // placed from, its runs driven from the next cycle to the window's last and numbered as
+  // the experiment's. Unset (auto): the cycle before the window (placed_cycle_for()).
+  std::optional<std::int64_t> placed_cycle;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
   // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
@@ -134,6 +139,13 @@ struct CalibrateOptions {
   void validate() const;
 };
 
+// The cycles compared: the window given, else the experiment's last 10 (a --window auto
+// starts there too, before the twin's runs move it).
+std::pair<std::int64_t, std::int64_t> compared_window(const CalibrateOptions& options,
+                                                      const TrajectoryReader& experiment);
+// The experiment's cycle a placed twin starts from: placed_cycle where given, else the one
+// before the window (with --window auto, chosen from the runs, the experiment's first).
+std::int64_t placed_cycle_for(const CalibrateOptions& options, const TrajectoryReader& experiment);
 // The preparation `options` ask for, automatic resolved for `experiment`.
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
                                      const TrajectoryReader& experiment);
@@ -179,6 +191,9 @@ std::optional<double> parse_axis_noise(const std::string& text, const std::strin
 // --placed-jitter's text: auto (NaN, CalibrateOptions::placed_jitter's default) or a length
 // in m; Error naming `option` otherwise.
 double parse_placed_jitter(const std::string& text, const std::string& option);
+// --placed-cycle's text: auto (unset: the cycle before the window) or a cycle >= 0; Error
+// naming `option` otherwise.
+std::optional<std::int64_t> parse_placed_cycle(const std::string& text, const std::string& option);
 
 // Whether a `simulate` setting may be given to the twin: calibrate sets the runs' output,
 // cycles and mu_s itself, and the twin keeps no checkpoints, tracks or samples.

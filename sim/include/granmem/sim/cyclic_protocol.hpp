@@ -18,6 +18,10 @@ namespace granmem {
 struct CyclicOptions {
   WallDrive drive;
   std::int64_t cycles = 1;
+  // The cycle the packing stands after when the run starts, its first frame's number: 0 for
+  // a prepared packing; N for one placed where an experiment's frame of cycle N has its
+  // grains, so that the run's cycles are numbered as the experiment's (N+1 to `cycles`).
+  std::int64_t first_cycle = 0;
   std::filesystem::path out;  // end-of-cycle trajectory store
   // Also a store of frames at full compression: <out stem>_full_compression.h5.
   bool full_compression_frames = false;
@@ -71,9 +75,9 @@ RunHeader cyclic_run_header(const Simulation& sim, const std::vector<std::size_t
 // <out stem>_state_cycle<cycle>.h5
 std::filesystem::path kept_state_path(const std::filesystem::path& out, std::int64_t cycle);
 
-// Runs the cycles from `state` (a fresh ProtocolState starts at cycle 1 and writes the
-// state before it as frame 0; one read from a checkpoint continues where it stopped,
-// appending to the outputs). End-of-cycle frames hold every grain's position, orientation
+// Runs the cycles from `state` (a fresh ProtocolState starts at cycle first_cycle + 1 and
+// writes the state before it as frame first_cycle; one read from a checkpoint continues where it
+// stopped, appending to the outputs). End-of-cycle frames hold every grain's position, orientation
 // and cavity axis; per-cycle observables: wall_force and wall_force_full_compression (N,
 // the packing's push on the driven wall), lid_height (m), packing_fraction,
 // kinetic_energy (J), contacts_per_grain. Checks `stop` every step: when set, it writes

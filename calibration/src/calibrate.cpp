@@ -185,9 +185,10 @@ CalibrateOptions resolved_options(const CalibrateOptions& given,
     throw Error("--placed-cycle " + std::to_string(*options.placed_cycle) +
                 ": only for a twin placed from the experiment; this one is " +
                 (asked ? std::string("--deposit ") + preparation_name(given.preparation)
-                       : "poured (that frame of " + given.experiment.string() +
-                             " does not hold its packing exactly, or the fit is not mu_s's "
-                             "on the steady state); --deposit experiment places it"));
+                       : "poured (" + given.experiment.string() + " has no frame of cycle " +
+                             std::to_string(*options.placed_cycle) +
+                             " holding its packing exactly, or the fit is not mu_s's on the "
+                             "steady state); --deposit experiment places it"));
   }
   return options.with_default_design();
 }
@@ -751,7 +752,8 @@ Comparison compare_at_fit(const Twin& twin, const FrictionRunSpec& best,
   std::string label = "DEM mu_s = " + number_text(best.mu_s);
   if (best.mu_r >= 0) label += ", mu_r = " + number_text(best.mu_r);
   return compare_runs(twin.experiment(), TrajectoryReader(twin.path(best)), "experiment", label,
-                      twin.observe, noise_shape, noise_sigma, twin.options().out);
+                      twin.observe, noise_shape, noise_sigma, twin.options().out, {},
+                      twin.first_cycle());
 }
 
 // The members every summary.json ends with.
@@ -1369,9 +1371,9 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
     run_mu.push_back(spec.mu_s);
   const std::vector<fs::path> figures = calibration_figures(o.out, fit, run_mu);
   s.written.insert(s.written.end(), figures.begin(), figures.end());
-  const Comparison compared = compare_runs(twin.experiment(), best_run, "experiment",
-                                           "DEM mu_s = " + number_text(best.mu_s), twin.observe,
-                                           fit_options.noise_shape, fit.noise_sigma, o.out);
+  const Comparison compared = compare_runs(
+      twin.experiment(), best_run, "experiment", "DEM mu_s = " + number_text(best.mu_s),
+      twin.observe, fit_options.noise_shape, fit.noise_sigma, o.out, {}, twin.first_cycle());
   add_comparison(s, report, compared);
   auto distance = [&](const std::string& q, bool wasserstein) {
     const auto it = compared.distances.find(q);
@@ -1487,6 +1489,11 @@ void CalibrateOptions::validate() const {
     throw Error("--placed-jitter: a length > 0 (replicas not moved would all be the same run)");
   }
   if (placed_cycle && *placed_cycle < 0) throw Error("--placed-cycle: a cycle, 0 or later");
+  if (placed_cycle && auto_window) {
+    throw Error(
+        "--placed-cycle: not with --window auto (the window is chosen from runs that "
+        "start from the experiment's first frame)");
+  }
   if (degree < 1) throw Error("--degree: at least 1");
   // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
   const std::size_t needed = std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);

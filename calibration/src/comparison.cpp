@@ -56,7 +56,8 @@ bool relaxation_of(const std::string& label, const std::vector<std::int64_t>& cy
 Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                         const std::string& label_a, const std::string& label_b,
                         const ObservableOptions& observe, const Eigen::Vector3d& noise_shape,
-                        double sigma, const fs::path& dir, const PowerLawOptions& relaxation) {
+                        double sigma, const fs::path& dir, const PowerLawOptions& relaxation,
+                        std::int64_t b_placed_after) {
   ObservableOptions oa = observe, ob = observe;
   oa.rotations = a.header().has_axis || a.header().has_orientation;
   ob.rotations = b.header().has_axis || b.header().has_orientation;
@@ -127,10 +128,16 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                     "End-of-cycle displacements, cycles " + std::to_string(observe.window.first) +
                         "-" + std::to_string(observe.window.second)));
 
-  // Fig. 3: relaxation towards the steady state.
+  // Fig. 3: relaxation towards the steady state, from the preparation before cycle 1.
   std::vector<Relaxation> trans, rot;
+  const bool b_relaxes = b_placed_after <= 0;
+  if (!b_relaxes) {
+    result.notes.push_back("no power law for " + label_b + ": placed after cycle " +
+                           std::to_string(b_placed_after) +
+                           ", it relaxes from there, not from a preparation before cycle 1");
+  }
   relaxation_of(label_a, x.cycle, x.mean_dr, relaxation, &trans, &result.notes);
-  relaxation_of(label_b, y.cycle, y.mean_dr, relaxation, &trans, &result.notes);
+  if (b_relaxes) relaxation_of(label_b, y.cycle, y.mean_dr, relaxation, &trans, &result.notes);
   if (!trans.empty()) {
     add(plot_relaxation(dir, "relaxation_translation", trans,
                         "mean displacement per cycle - steady state [d]",
@@ -138,7 +145,7 @@ Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
   }
   if (oa.rotations)
     relaxation_of(label_a, x.cycle, x.mean_rot_disp, relaxation, &rot, &result.notes);
-  if (ob.rotations)
+  if (ob.rotations && b_relaxes)
     relaxation_of(label_b, y.cycle, y.mean_rot_disp, relaxation, &rot, &result.notes);
   if (!rot.empty()) {
     add(plot_relaxation(dir, "relaxation_rotation", rot,

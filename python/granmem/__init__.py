@@ -375,5 +375,5 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
-                              str(placed_cycle), bool(fit_only), _optional_float(true_mu_s),
+                              "auto" if placed_cycle is None else str(placed_cycle), bool(fit_only), _optional_float(true_mu_s),
                               _optional_float(true_mu_r), int(parallel), twin, progress)

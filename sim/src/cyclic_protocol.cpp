@@ -381,6 +381,10 @@ void CyclicOptions::validate(double box_y, double dt) const {
   }
   for (std::int64_t c : keep_states) {
     if (c < 0) throw Error("kept state after cycle " + std::to_string(c) + ": cycles count from 0");
+    if (c < first_cycle) {
+      throw Error("kept state after cycle " + std::to_string(c) + ": the run starts after cycle " +
+                  std::to_string(first_cycle));
+    }
   }
 }
 

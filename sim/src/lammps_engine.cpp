@@ -330,6 +330,8 @@ void check_lammps_protocol(const CyclicOptions& o, bool one_grain_size, bool lid
         "--engine lammps writes end-of-cycle frames only: --full-compression, "
         "--samples-per-cycle and --keep-states need --engine granmem");
   }
+  if (o.first_cycle != 0)
+    throw Error("--engine lammps numbers its cycles from 0: a run placed later needs granmem");
 }
 
 std::filesystem::path lammps_folder(const std::filesystem::path& out) {

@@ -344,6 +344,9 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   expect_clean_failure(from_start, {"--placed-cycle 2", "before the window"});
   from_start.back() = "first";
   expect_clean_failure(from_start, {"--placed-cycle 'first'", "a cycle, 0 or later"});
+  expect_clean_failure(
+      calibrate({"--window", "auto", "--mu-s", "0.1,0.2,0.4", "--fit-only", "--placed-cycle", "0"}),
+      {"--placed-cycle", "not with --window auto"});
   // Placed runs are reused only for the same packing placed the same way.
   std::vector<std::string> again = design;
   EXPECT_NE(granmem_ok(calibrate(again)).err.find("reusing 6 finished runs"), std::string::npos);
@@ -351,6 +354,11 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   again.erase(std::find(again.begin(), again.end(), "--fit-only"));
   const RunResult compared_design = granmem_ok(calibrate(again));
   expect_compared_at_a_run_inside(read_text(in_work("cal/summary.json")), compared_design.out, 6);
+  // No relaxation fitted to the twin's run: it relaxes from its placing.
+  EXPECT_NE((compared_design.out + compared_design.err)
+                .find(": placed after cycle 1, it relaxes from there, not from a preparation"),
+            std::string::npos)
+      << compared_design.err;
   again.push_back("--fit-only");
   again.insert(again.end(), {"--placed-jitter", "1um"});
   EXPECT_EQ(granmem_ok(calibrate(again)).err.find("reusing"), std::string::npos);

@@ -217,6 +217,9 @@ TEST_F(Restart, ARunNumberedFromALaterCycleIsTheSameRun) {
       EXPECT_EQ(ob.step[k], oa.step[k] + 4) << name;
     EXPECT_TRUE(same_array(oa.value.data(), ob.value.data(), oa.value.size(), name));
   }
+  b.keep_states = {3};  // before the run starts
+  EXPECT_THROW(b.validate(0.02, 25e-6), Error);
+  b.keep_states.clear();
   b.first_cycle = 7;  // no cycle left to run
   EXPECT_THROW(b.validate(0.02, 25e-6), Error);
 }

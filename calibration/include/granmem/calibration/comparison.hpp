@@ -24,7 +24,9 @@ namespace granmem {
 // for simulations one-axis against full rotations (Fig. 6). `b`'s displacements get the
 // locating noise `sigma` (voxels, `noise_shape`), as the friction fit sees them. The
 // relaxation's power laws are fitted with `relaxation` (the steady state fitted, or held
-// at the mean of the last cycles as the paper does).
+// at the mean of the last cycles as the paper does); not `b`'s where it was placed after
+// cycle `b_placed_after` > 0 (a twin placed from the experiment's frame there relaxes from
+// it, not from a preparation before cycle 1: said in the notes).
 struct Comparison {
   std::vector<std::filesystem::path> written;
   // quantity (dr, rot_disp) -> KS and Wasserstein-1 (grain diameters) distances
@@ -37,14 +39,14 @@ struct Comparison {
   friend Comparison compare_runs(const TrajectoryReader&, const TrajectoryReader&,
                                  const std::string&, const std::string&, const ObservableOptions&,
                                  const Eigen::Vector3d&, double, const std::filesystem::path&,
-                                 const PowerLawOptions&);
+                                 const PowerLawOptions&, std::int64_t);
   std::string report_;
 };
 Comparison compare_runs(const TrajectoryReader& a, const TrajectoryReader& b,
                         const std::string& label_a, const std::string& label_b,
                         const ObservableOptions& observe, const Eigen::Vector3d& noise_shape,
                         double sigma, const std::filesystem::path& dir,
-                        const PowerLawOptions& relaxation = {});
+                        const PowerLawOptions& relaxation = {}, std::int64_t b_placed_after = 0);
 
 // The friction fit's figure: the simulated CDF values at three of the experiment's deciles
 // against mu_s, the experiment's values beside them.

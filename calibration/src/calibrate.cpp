@@ -142,12 +142,23 @@ TwinPreparation preparation_named(const std::string& name, const std::string& op
   throw Error(option + " '" + name + "': expected each, shared, experiment or auto");
 }
 
+namespace {
+
+// The index of the run's frame of `cycle`, if it has one.
+std::optional<std::size_t> frame_of_cycle(const TrajectoryReader& run, std::int64_t cycle) {
+  const auto& steps = run.steps();
+  const auto at = std::find(steps.begin(), steps.end(), cycle);
+  if (at == steps.end()) return std::nullopt;
+  return std::size_t(at - steps.begin());
+}
+
+}  // namespace
+
 bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle) {
   const RunHeader& h = run.header();
   if (!h.has_orientation || h.has_position_error) return false;
-  const auto& steps = run.steps();
-  const auto at = std::find(steps.begin(), steps.end(), cycle);
-  return at != steps.end() && run.read_frame(std::size_t(at - steps.begin())).position.allFinite();
+  const std::optional<std::size_t> frame = frame_of_cycle(run, cycle);
+  return frame && run.read_frame(*frame).position.allFinite();
 }
 
 std::pair<std::int64_t, std::int64_t> compared_window(const CalibrateOptions& options,
@@ -528,9 +539,8 @@ class Twin {
   // seed); the runs drive the cycles after it, numbered as the experiment's.
   void place_experiments_grains() {
     placed_cycle_ = placed_cycle_for(o_, experiment_);
-    const auto& steps = experiment_.steps();
-    const auto at = std::find(steps.begin(), steps.end(), placed_cycle_);
-    if (at == steps.end()) {
+    const std::optional<std::size_t> frame = frame_of_cycle(experiment_, placed_cycle_);
+    if (!frame) {
       throw Error(o_.experiment.string() + ": --deposit experiment starts the twin from the " +
                   "experiment's frame of cycle " + std::to_string(placed_cycle_) +
                   (o_.placed_cycle ? " (--placed-cycle)" : " (the one before the window)") +
@@ -541,7 +551,7 @@ class Twin {
                   ": the twin must start before the window's first cycle (" +
                   std::to_string(observe.window.first) + ")");
     }
-    placed_ = grains_of_frame(experiment_, std::size_t(at - steps.begin()), deposit_, physics_);
+    placed_ = grains_of_frame(experiment_, *frame, deposit_, physics_);
     placed_jitter_ = std::isfinite(o_.placed_jitter) ? o_.placed_jitter
                                                      : kPlacedJitterDiameters * 2 * deposit_.radius;
   }

@@ -36,6 +36,10 @@ void analyze_and_report(const TrajectoryReader& run, const AnalysisOptions& opti
 // holds the command's default when called.
 void add_drift_flags(CLI::App* command, bool& subtract);
 
+// --readings FILE.csv, the apparatus' readings beside the scans or tracks (import, link,
+// track: core/apparatus_readings.hpp).
+void add_readings_option(CLI::App* command, std::string& readings);
+
 // The options of a subcommand as actually used (given or default), "<command>/<option>"
 // -> value, for the output's /parameters.
 std::map<std::string, std::string> used_options(const CLI::App& command);

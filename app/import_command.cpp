@@ -14,7 +14,7 @@ namespace granmem::app {
 void add_import(CLI::App& app) {
   struct Args {
     std::string table, out, length_unit = "voxel", voxel_size, container,
-                            sample = kSampleEndOfCycle, columns;
+                            sample = kSampleEndOfCycle, columns, readings;
     double radius = 0;
     std::size_t skip_rows = 0;
     std::vector<long long> types;
@@ -48,13 +48,14 @@ void add_import(CLI::App& app) {
   cmd->add_option("--types", args->types,
                   "LAMMPS dumps: the atom types that are grains, e.g. 1 (default: every atom)")
       ->delimiter(',');
+  add_readings_option(cmd, args->readings);
   cmd->add_option("--skip-rows", args->skip_rows,
                   "lines after the header that are not data (TrackMate's CSV: 3)")
       ->capture_default_str();
 
   cmd->callback([args, cmd, radius] {
     check_outputs({{"--out", args->out}, {"--out's XDMF", xdmf_path(args->out)}},
-                  {{"table", args->table}});
+                  {{"table", args->table}, {"--readings", args->readings}});
     ImportOptions options;
     options.length_unit = args->length_unit;
     if (radius->count()) options.radius = args->radius;
@@ -72,6 +73,7 @@ void add_import(CLI::App& app) {
     options.csv.rename = parse_renames(args->columns, "--columns");
     options.csv.skip_rows = args->skip_rows;
     options.types.insert(args->types.begin(), args->types.end());
+    options.readings = args->readings;
 
     ImportSummary summary;
     Trajectories run = import_table(args->table, options, &summary);

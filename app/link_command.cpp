@@ -23,6 +23,7 @@ LinkRunOptions link_run_options(const LinkArgs& args) {
   o.container = args.container;
   o.container_size = args.container_size;
   o.first_cycle = args.first_cycle;
+  o.readings = args.readings;
   return o;
 }
 
@@ -51,6 +52,7 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
                   "theirs: frames numbered from it in the order given (the last 10 of 500: "
                   "491)")
       ->capture_default_str();
+  add_readings_option(cmd, args.readings);
   cmd->add_option("--report", args.report,
                   "CSV of what could not be linked: tracks lost and detections starting a track");
 }
@@ -92,6 +94,7 @@ void add_link(CLI::App& app) {
     std::vector<NamedPath> inputs;
     for (const std::string& path : args->scans)
       inputs.push_back({"scan", path});
+    if (!args->link.readings.empty()) inputs.push_back({"--readings", args->link.readings});
     link_run_options(args->link).validate();
     check_outputs(link_outputs(args->link, args->out), inputs);
     std::vector<Detections> scans;

@@ -153,6 +153,7 @@ void add_track(CLI::App& app) {
         outputs.push_back({"--detections of " + scan, detections_path(args->detections, scan)});
       }
     }
+    if (!args->link.readings.empty()) inputs.push_back({"--readings", args->link.readings});
     check_outputs(outputs, inputs);
     const TrackSummary tracked = track_run(options);
     for (const std::string& note : tracked.linked.notes)

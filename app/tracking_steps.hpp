@@ -29,7 +29,7 @@ ScanLocateOptions scan_locate_options(const LocateArgs& args);
 Detections locate_scan(const std::string& path, const LocateArgs& args, std::int64_t frame);
 
 struct LinkArgs {
-  std::string max_displacement = "auto", report, container, container_size;
+  std::string max_displacement = "auto", report, container, container_size, readings;
   int memory = 2;
   std::int64_t first_cycle = 0;
   bool no_drift = false;

@@ -27,4 +27,12 @@ void add_drift_flags(CLI::App* command, bool& subtract) {
                         (subtract ? "subtracted" : "kept") + ")");
 }
 
+void add_readings_option(CLI::App* command, std::string& readings) {
+  command->add_option("--readings", readings,
+                      "CSV of the apparatus' readings, cycle by cycle: columns cycle and "
+                      "wall_force_full_compression and/or wall_force_unloaded (N, the "
+                      "packing's force on the driven wall), stored with the tracks for "
+                      "calibrate");
+}
+
 }  // namespace granmem::app

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "granmem/core/apparatus_readings.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/lammps_dump.hpp"
 #include "granmem/core/memory_budget.hpp"
@@ -34,6 +35,7 @@ void ImportOptions::validate() const {
   if (radius && !(*radius > 0 && std::isfinite(*radius))) {
     throw Error("--radius: expected a positive radius");
   }
+  if (!readings.empty()) read_apparatus_readings(readings);
 }
 
 namespace {
@@ -457,17 +459,26 @@ Trajectories import_dump(const std::filesystem::path& path, const ImportOptions&
   return run;
 }
 
+// The run with the apparatus' readings of options.readings, said in the summary's notes.
+Trajectories with_readings(Trajectories run, const ImportOptions& options, ImportSummary* summary) {
+  if (options.readings.empty()) return run;
+  const std::string said = attach_apparatus_readings(run, options.readings);
+  if (summary) summary->notes.push_back(said);
+  return run;
+}
+
 }  // namespace
 
 Trajectories import_table(const std::filesystem::path& csv, const ImportOptions& options,
                           ImportSummary* summary) {
   options.validate();  // before the file is read
-  if (is_lammps_dump(csv)) return import_dump(csv, options, summary);
+  if (is_lammps_dump(csv))
+    return with_readings(import_dump(csv, options, summary), options, summary);
   const CsvColumns read = read_csv(csv, kRequiredColumns, kOptionalColumns, options.csv);
   Trajectories run =
       import_rows(read.table, read.lines, Source{csv.string(), "line"}, options, summary);
   if (summary) summary->format = "csv";
-  return run;
+  return with_readings(std::move(run), options, summary);
 }
 
 Trajectories import_table(const Table& table, const std::string& source,
@@ -478,7 +489,8 @@ Trajectories import_table(const Table& table, const std::string& source,
   }
   std::vector<std::size_t> rows(table.rows());
   std::iota(rows.begin(), rows.end(), std::size_t{1});
-  return import_rows(table, rows, Source{source, "row"}, options, summary);
+  return with_readings(import_rows(table, rows, Source{source, "row"}, options, summary), options,
+                       summary);
 }
 
 }  // namespace granmem

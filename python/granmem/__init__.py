@@ -176,17 +176,20 @@ def read_tracks(path):
     return _frame(columns, units, length_unit=run_unit)
 
 
-def write_run(tracks, path, length_unit=None, radius=None):
+def write_run(tracks, path, length_unit=None, radius=None, readings=None):
     """Writes tracks (frame, particle, x, y, z and optionally radius, ax, ay, az,
     hole_contact, the standard errors ep_x, ep_y, ep_z or trackpy's ep, and axis_error in
     rad) as a trajectory store that ``granmem analyze``, ``compare`` and
     ``calibrate`` read; written atomically. ``radius``: of every grain, for tables without
-    a radius column."""
+    a radius column. ``readings``: a CSV of the apparatus' readings, cycle by cycle (columns
+    cycle and wall_force_full_compression and/or wall_force_unloaded, in N), stored with
+    the tracks as ``--readings`` does on the command line."""
     unit = length_unit or tracks.attrs.get("length_unit", "voxel")
     names = ["frame", "particle", "x", "y", "z", "radius", "ax", "ay", "az", "hole_contact",
              "ep", "ep_x", "ep_y", "ep_z", "axis_error"]
     _granmem.write_run(_columns(tracks, names), os.fspath(path), unit,
-                       None if radius is None else float(radius))
+                       None if radius is None else float(radius),
+                       None if readings is None else os.fspath(readings))
 
 
 def motion(run, before, after, subtract_drift=False, wall_distance=0,

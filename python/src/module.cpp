@@ -336,14 +336,17 @@ ImportOptions import_options(const std::string& length_unit, const std::optional
 }
 
 Trajectories run_of_table(const py::dict& columns, const std::string& length_unit,
-                          const std::optional<double>& radius) {
-  return import_table(table_of(columns, length_unit, "tracks"), "tracks",
-                      import_options(length_unit, radius));
+                          const std::optional<double>& radius,
+                          const std::filesystem::path& readings = {}) {
+  ImportOptions o = import_options(length_unit, radius);
+  o.readings = readings;
+  return import_table(table_of(columns, length_unit, "tracks"), "tracks", o);
 }
 
 void write_run_py(const py::dict& columns, const std::filesystem::path& path,
-                  const std::string& length_unit, const std::optional<double>& radius) {
-  const Trajectories run = run_of_table(columns, length_unit, radius);
+                  const std::string& length_unit, const std::optional<double>& radius,
+                  const std::optional<std::filesystem::path>& readings) {
+  const Trajectories run = run_of_table(columns, length_unit, radius, readings.value_or(""));
   py::gil_scoped_release release;
   write_trajectories(path, run);
 }
@@ -915,7 +918,7 @@ PYBIND11_MODULE(_granmem, m) {
       },
       py::arg("path"));
   m.def("write_run", &write_run_py, py::arg("columns"), py::arg("path"), py::arg("length_unit"),
-        py::arg("radius") = py::none());
+        py::arg("radius") = py::none(), py::arg("readings") = py::none());
   m.def("simulate", &simulate_py, py::arg("settings"), py::arg("resume") = "",
         py::arg("start_from") = "", py::arg("threads") = 0, py::arg("progress") = py::none());
   m.def("calibrate", &calibrate_py, py::arg("experiment"), py::arg("out"),

@@ -118,6 +118,28 @@ def test_store_round_trip_and_the_command_line_agree(tmp_path, cli):
     assert "theta_axis" in a.columns  # the table had cavity axes
 
 
+def test_the_apparatus_readings_are_stored_with_the_tracks(tmp_path, cli):
+    first, second, _ = moved_lattice()
+    table = pd.concat([first.assign(frame=0), second.assign(frame=1)])
+    (tmp_path / "readings.csv").write_text("cycle,wall_force_full_compression\n0,11.5\n1,12.0\n")
+    granmem.write_run(table, tmp_path / "run.h5", length_unit="mm",
+                      readings=tmp_path / "readings.csv")
+    force = granmem.read_run(tmp_path / "run.h5")["observables"]["wall_force_full_compression"]
+    np.testing.assert_array_equal(force["value"], [11.5, 12.0])
+    np.testing.assert_array_equal(force["step"], [0, 1])
+    # The command line's import stores the same.
+    table.to_csv(tmp_path / "tracks.csv", index=False)
+    cli("import", "tracks.csv", "--length-unit", "mm", "--readings", "readings.csv",
+        "--out", "cli.h5")
+    same = granmem.read_run(tmp_path / "cli.h5")["observables"]["wall_force_full_compression"]
+    np.testing.assert_array_equal(same["value"], force["value"])
+    (tmp_path / "readings.csv").write_text("cycle,wall_force_unloaded\n1,-2\n")
+    with pytest.raises(granmem.Error, match="expected a force >= 0 in N"):
+        granmem.write_run(table, tmp_path / "x.h5", length_unit="mm",
+                          readings=tmp_path / "readings.csv")
+    assert not (tmp_path / "x.h5").exists()
+
+
 def test_bad_tables_are_one_clear_error(tmp_path):
     with pytest.raises(granmem.Error, match="no column 'particle'"):
         granmem.write_run(pd.DataFrame({"frame": [0], "x": [1.0], "y": [1.0], "z": [1.0]}),

@@ -155,6 +155,22 @@ TEST_F(LinkCommandTest, LinksReportsAndAnalyzes) {
   EXPECT_TRUE(fs::exists(in_work("analysis")));
 }
 
+TEST_F(LinkCommandTest, TheApparatusReadingsAreStoredWithTheTracks) {
+  write_text(in_work("readings.csv"),
+             "cycle,wall_force_full_compression,wall_force_unloaded\n1,12.5,3\n2,12.25,3.5\n");
+  const RunResult r = granmem_ok({"link", "scan0.h5", "scan1.csv", "scan2.csv", "--out",
+                                  "tracks.h5", "--readings", "readings.csv"});
+  EXPECT_NE(r.err.find("the wall's force at full compression at 2 cycles, unloaded at 2 cycles"),
+            std::string::npos)
+      << r.err;
+  // Under the names a simulation's store gives them, which calibrate compares.
+  const Trajectories run = read_trajectories(in_work("tracks.h5"));
+  EXPECT_EQ(run.observables.at("wall_force_full_compression").value,
+            (std::vector<double>{12.5, 12.25}));
+  EXPECT_EQ(run.observables.at("wall_force").value, (std::vector<double>{3, 3.5}));
+  EXPECT_EQ(run.observables.at("wall_force").step, (std::vector<std::int64_t>{1, 2}));
+}
+
 TEST_F(LinkCommandTest, ConfigSection) {
   // [link] in a TOML file: no memory, so the missing grain starts a second track.
   write_text(in_work("granmem.toml"), "[link]\nmemory = 0\nmax-displacement = \"0.45 mm\"\n");
@@ -242,6 +258,10 @@ TEST_F(LinkBadInputTest, Errors) {
   expect_clean_failure(
       {"link", "scan0.h5", "scan1.csv", "--out", "t.h5", "--max-displacement", "2 parsecs"},
       {"--max-displacement"});
+  write_text(in_work("readings.csv"), "cycle,lid_height\n1,0.05\n");
+  expect_clean_failure(
+      {"link", "scan0.h5", "scan1.csv", "--out", "t.h5", "--readings", "readings.csv"},
+      {"readings.csv", "no column wall_force_full_compression"});
   // An existing result is left as it was.
   write_text(in_work("t.h5"), "keep me");
   expect_clean_failure({"link", "scan0.h5", "voxels.csv", "--out", "t.h5"}, {"one length unit"});

@@ -4,6 +4,7 @@
 #include <optional>
 #include <sstream>
 
+#include "granmem/core/apparatus_readings.hpp"
 #include "granmem/core/atomic_file.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/option_values.hpp"
@@ -96,6 +97,7 @@ void LinkRunOptions::validate() const {
     throw Error("--container and --container-size: give the container or its size, not both");
   }
   if (!container_size.empty()) parse_edges(container_size, "m", "--container-size");
+  if (!readings.empty()) read_apparatus_readings(readings);  // its errors before any scan's
   if (container.empty()) return;
   const Quantity last = parse_quantity_list(container, "--container").back();
   if (!is_physical_length_unit(last.unit)) {
@@ -117,6 +119,8 @@ LinkRun link_run(std::vector<Detections> scans, const std::vector<std::string>& 
   const std::string unit = scans.front().length_unit;
   r.run = link_scans(scans, link_options(options, unit), &r.summary);
   register_run(r, options, unit);
+  if (!options.readings.empty())
+    r.notes.push_back(attach_apparatus_readings(r.run, options.readings));
   r.scans = std::move(scans);
   return r;
 }
@@ -189,6 +193,8 @@ std::vector<std::filesystem::path> write_link_run(
   TrajectoryWriter writer(out, header);
   for (const Frame& frame : linked.run.frames)
     writer.append(frame);
+  for (const auto& [name, observable] : linked.run.observables)
+    writer.set_observable(name, observable);
   std::optional<AtomicFile> table;
   if (!report.empty()) {
     table.emplace(report);

@@ -36,6 +36,9 @@ struct ImportOptions {
   // LAMMPS dumps: the atom types that are grains (not a lid or wall particles); empty
   // keeps every atom.
   std::set<long long> types;
+  // The apparatus' readings beside the table (a load cell's force on the driven wall, cycle
+  // by cycle: apparatus_readings.hpp), stored as the run's observables. Empty: none.
+  std::filesystem::path readings;
 
   // Throws Error naming the option: an unknown length unit, a voxel size without voxel
   // coordinates, a length unit or three positive sizes, a radius that is not positive.

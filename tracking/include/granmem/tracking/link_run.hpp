@@ -29,6 +29,9 @@ struct LinkRunOptions {
   // The cycle at whose end the first scan was taken, when the scans do not say theirs: the
   // scans are then frames first_cycle, first_cycle + 1, ... (e.g. the last 10 of 500).
   std::int64_t first_cycle = 0;
+  // The apparatus' readings beside the scans (a load cell's force on the driven wall, cycle
+  // by cycle: core/apparatus_readings.hpp), stored as the run's observables. Empty: none.
+  std::filesystem::path readings;
   // A line per scan as it is linked, and a flag that stops between two (LinkOptions).
   std::function<void(const std::string&)> log;
   const std::atomic<bool>* stop = nullptr;

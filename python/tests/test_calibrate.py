@@ -136,7 +136,8 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     # Scans in voxels of 0.1 mm whose centres err by 0.2 mm (4 % of a diameter) while their
     # standard errors say 1 um: the touching neighbours' spread reads the actual error, and
     # the noise check, measured with it, leaves out the height the noise moves (with the
-    # standard errors alone it would keep it, as for the scans located to 1 um above).
+    # standard errors alone it would keep it, as for the scans located to 1 um above). The
+    # twin is placed from them (their standard errors are fine) and read against its run.
     voxel, sigma = 1e-4, 2e-4
     tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
     lo, hi = granmem.read_run(experiment)["box"]
@@ -157,6 +158,9 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     assert "height_packing_fraction" in summary["left_out_for_scan_noise"]
     assert "height_packing_fraction left out: the scans' own locating noise (their contacts' " \
         "error) moves it by" in fit["report"]
+    # Their standard errors (1 um) had the twin placed from them: the contacts say it leans.
+    assert summary["deposit"] == "experiment"
+    assert "more than 0.003 d: the twin's packings settle denser" in fit["report"]
 
 
 def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):

@@ -301,8 +301,8 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
 // --deposit experiment: every run starts from the experiment's own packing, the grains of
 // its frame before the window jittered by the run's seed and settled at the run's friction,
 // and drives the cycles after it: at the true friction the twin starts where the experiment
-// stands, its pour's scatter gone. The default (auto) does so for a simulation's packing,
-// and pours for scans.
+// stands, its pour's scatter gone. The default (auto) does so for a simulation's packing
+// and for fine scans that locate nearly every grain, and pours for other scans.
 TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   const std::vector<std::string> design{"--window",      "2:3",          "--mu-s",    "0.1,0.2,0.4",
                                         "--observables", "steady-state", "--fit-only"};
@@ -416,7 +416,26 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   scans_from.insert(scans_from.end(), {"--placed-cycle", "1"});
   expect_clean_failure(scans_from, {"--placed-cycle 1", "this one is poured"});
   from_scans.insert(from_scans.end(), {"--deposit", "experiment"});
-  EXPECT_NE(granmem_ok(from_scans).err.find("fit leans to higher friction"), std::string::npos);
+  EXPECT_NE(granmem_ok(from_scans).err.find("lean the fit to higher friction"), std::string::npos);
+  // A fine scan (standard errors 0.0006 d) that locates every grain is placed by default,
+  // the same packing as the simulation's (its runs reused); one that misses 2 of the 60
+  // grains before the window is poured.
+  for (Frame& f : scans.frames)
+    f.position_error.setConstant(0.0006 * d);
+  write_trajectories(in_work("fine.h5"), scans);
+  std::vector<std::string> fine = calibrate(design);
+  fine[2] = "fine.h5";
+  const RunResult placed_fine = granmem_ok(fine);
+  EXPECT_NE(placed_fine.err.find("placed where the experiment's frame of cycle 1 has its 60"),
+            std::string::npos)
+      << placed_fine.err;
+  EXPECT_NE(placed_fine.err.find("reusing 6 finished runs"), std::string::npos) << placed_fine.err;
+  for (Frame& f : scans.frames)
+    if (f.step == 1) f.position.topRows(2).setConstant(std::nan(""));
+  write_trajectories(in_work("missed.h5"), scans);
+  fine[2] = "missed.h5";
+  fine[4] = "missed";
+  EXPECT_NE(granmem_ok(fine).err.find("deposited at each friction"), std::string::npos);
   // A store whose first frame is after cycle 1, not the packing before the first cycle: the
   // default places it (it precedes the window); placed from cycle 0, refused.
   Trajectories later = read_trajectories(in_work("exp.h5"));

@@ -54,9 +54,9 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
 
 class ResolvedOptions : public testing::TempDirTest {
  protected:
-  // A two-grain store whose first frame is cycle 0: a simulation's (orientations), or a
-  // scan's (positions' standard errors).
-  std::filesystem::path store(bool scan) {
+  // A two-grain store of 5 mm grains whose first frame is cycle 0: a simulation's
+  // (orientations), or a scan's (positions' standard errors of `error`, m).
+  std::filesystem::path store(bool scan, double error = 0) {
     Trajectories t;
     t.header.id = {1, 2};
     t.header.radius = {0.0025, 0.0025};
@@ -66,13 +66,13 @@ class ResolvedOptions : public testing::TempDirTest {
     Frame f = Frame::unknown(t.header);
     f.position << 0.005, 0.005, 0.0025, 0.012, 0.005, 0.0025;
     if (scan) {
-      f.position_error.setConstant(5e-6);
+      f.position_error.setConstant(error);
     } else {
       f.orientation.setZero();
       f.orientation.col(0).setOnes();  // the identity
     }
     t.frames.push_back(f);
-    const auto p = path(scan ? "scan.h5" : "sim.h5");
+    const auto p = path(scan ? "scan_" + std::to_string(error) + ".h5" : "sim.h5");
     write_trajectories(p, t);
     return p;
   }
@@ -87,7 +87,11 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneItsOwn) {
   EXPECT_EQ(placed.mu_s.back(), 0.6);
   EXPECT_EQ(placed.replicas, 2);
   EXPECT_EQ(placed.refine, 4);
-  const CalibrateOptions poured = resolved_options(steady, TrajectoryReader(store(true)));
+  // A coarse scan (0.005 d, as a 9-pixel render's) is poured; a fine one (0.001 d, the
+  // default render's) is placed as a simulation's packing is (kPlaceableScanError).
+  EXPECT_EQ(resolved_options(steady, TrajectoryReader(store(true, 5e-6))).preparation,
+            TwinPreparation::experiment);
+  const CalibrateOptions poured = resolved_options(steady, TrajectoryReader(store(true, 25e-6)));
   EXPECT_EQ(poured.preparation, TwinPreparation::each);
   EXPECT_EQ(poured.mu_s.back(), 0.4);
   EXPECT_EQ(poured.replicas, 3);

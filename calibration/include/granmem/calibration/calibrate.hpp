@@ -31,9 +31,9 @@ enum class CalibrationObservables { displacements, steady_state };
 // output folder) and its friction switched before the drive, or each run starts from the
 // experiment's own packing, the grains of its frame before the window (placed_packing.hpp;
 // CalibrateOptions::placed_cycle) jittered by the run's seed and settled at the run's
-// friction. Automatic: the experiment's own packing where that frame holds it exactly
-// (exact_packing_at()) and the fit is mu_s's on the steady state, where it was measured
-// (docs/CALIBRATION.md); else each its own.
+// friction. Automatic: the experiment's own packing where that frame holds it exactly or
+// within a fine scan's errors (placeable_packing_at()) and the fit is mu_s's on the steady
+// state, where it was measured (docs/CALIBRATION.md); else each its own.
 enum class TwinPreparation { each, shared, experiment, automatic };
 // The settings that make the protocol: a pseudo-experiment simulated by granmem says what
 // it used, the twin takes them where its caller did not set them, and they must agree.
@@ -55,6 +55,22 @@ TwinPreparation preparation_named(const std::string& name, const std::string& op
 // locating errors, and a packing placed from it settles denser (a 2,500-grain packing
 // placed with 20 um errors, 0.0016 in packing fraction).
 bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle);
+// Whether a twin placed from the run's frame of `cycle` starts where the packing was: the
+// frame holds it exactly, or it is a scan whose centres' standard errors (RMS along each
+// axis) are within kPlaceableScanError grain diameters and which locates at least
+// kPlaceableScanFound of the run's grains (the rest are taken from later frames). Measured
+// (docs/CALIBRATION.md, "The wall's force read beside the scans"): scans of the default
+// render, standard errors 0.0009-0.0011 d and actual errors 7 and 15 um on 5 mm grains,
+// placed a twin whose fits held as the DEM's own positions did; coarse scans' standard
+// errors are 0.005 d, their actual errors 130-190 um, and 20 um already settles denser.
+// Standard errors understate a scan's actual error (1.6-2.8x on the default render), so
+// the contacts' reading checks it after the runs (kPlaceableContactError).
+inline constexpr double kPlaceableScanError = 0.0012;
+// A placed twin's scans whose contacts read a larger error (RMS a coordinate, in grain
+// diameters) than this are said to lean the fit (the default render's read 0.0021 d).
+inline constexpr double kPlaceableContactError = 0.003;
+inline constexpr double kPlaceableScanFound = 0.99;
+bool placeable_packing_at(const TrajectoryReader& run, std::int64_t cycle);
 
 struct CalibrateOptions {
   std::filesystem::path experiment;  // the experiment's trajectory store

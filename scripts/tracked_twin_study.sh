@@ -4,8 +4,9 @@
 # placed twin takes its grains) and of each cycle from one before the window to its end,
 # default render (12 pixels a grain, each scan its own noise seed), each scan located
 # apart and the detections linked across the gap; then the steady-state fit twice, the
-# twin placed where the scans' cycle 0 has the grains (the placed default design) and
-# poured (the scans' default).
+# twin placed where the scans have the grains before the window (cycle 0 until session 26;
+# the placed default design; fine scans' default since session 27) and poured (--deposit
+# each, the scans' default before).
 #
 #   scripts/tracked_twin_study.sh PSEUDO.h5 PROTOCOL.toml FIRST:LAST OUT [GRANMEM]
 #

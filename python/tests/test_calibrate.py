@@ -134,10 +134,11 @@ def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experime
 
 def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     # Scans in voxels of 0.1 mm whose centres err by 0.2 mm (4 % of a diameter) while their
-    # standard errors say 1 um: the touching neighbours' spread reads the actual error, and
-    # the noise check, measured with it, leaves out the height the noise moves (with the
-    # standard errors alone it would keep it, as for the scans located to 1 um above). The
-    # twin is placed from them (their standard errors are fine) and read against its run.
+    # standard errors say 1 um: the touching neighbours' spread reads the actual error. Their
+    # standard errors being fine, the twin is placed from them by default, and the contacts,
+    # read against its run, say that it leans; poured, the noise check, measured with the
+    # contacts' error, leaves out the height the noise moves (with the standard errors alone
+    # it would keep it, as for the scans located to 1 um above).
     voxel, sigma = 1e-4, 2e-4
     tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
     lo, hi = granmem.read_run(experiment)["box"]
@@ -149,18 +150,20 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     tracks.to_csv(tmp_path / "scans.csv", index=False)
     cli("import", "scans.csv", "--out", "scans.h5", "--voxel-size", "0.1mm",
         "--container", ",".join(str(v / voxel) for v in (*lo, *hi)))
-    fit = granmem.calibrate(tmp_path / "scans.h5", tmp_path / "cal", true_mu_s=0.2, **FIT,
-                            **TWIN)
-    assert fit["true_mu_s"] == 0.2  # given: scans drawn from a simulation do not carry it
-    summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
-    contacts = summary["locating_error_from_contacts"]
-    assert 130 < contacts["across_um"] < 300 and 130 < contacts["along_z_um"] < 300
+    for deposit in ("auto", "each"):
+        out = tmp_path / deposit
+        fit = granmem.calibrate(tmp_path / "scans.h5", out, true_mu_s=0.2, deposit=deposit,
+                                **FIT, **TWIN)
+        assert fit["true_mu_s"] == 0.2  # given: scans drawn from a simulation do not carry it
+        summary = json.loads((out / "summary.json").read_text())
+        contacts = summary["locating_error_from_contacts"]
+        assert 130 < contacts["across_um"] < 300 and 130 < contacts["along_z_um"] < 300
+        placed = deposit == "auto"
+        assert summary["deposit"] == ("experiment" if placed else "each")
+        assert ("more than 0.003 d: the twin's packings settle denser" in fit["report"]) == placed
     assert "height_packing_fraction" in summary["left_out_for_scan_noise"]
     assert "height_packing_fraction left out: the scans' own locating noise (their contacts' " \
         "error) moves it by" in fit["report"]
-    # Their standard errors (1 um) had the twin placed from them: the contacts say it leans.
-    assert summary["deposit"] == "experiment"
-    assert "more than 0.003 d: the twin's packings settle denser" in fit["report"]
 
 
 def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):

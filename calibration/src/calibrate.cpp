@@ -1005,10 +1005,11 @@ bool judged_by_contacts(const Twin& twin, const ContactLocatingError& contacts) 
 
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
                                         const std::vector<double>& scatter,
-                                        const ContactLocatingError& contacts) {
+                                        const ScanNoise& noise) {
   Eigen::Vector3d e = twin.errors.position;
   double share = kNoiseShare;
-  if (judged_by_contacts(twin, contacts)) {
+  if (noise.judged_by_contacts) {
+    const ContactLocatingError& contacts = noise.contacts;
     e = Eigen::Vector3d(contacts.across, contacts.across, contacts.along_z) /
         metres_per_length(twin.experiment());
     share = kContactsNoiseShare;
@@ -1049,7 +1050,7 @@ Fit without_noise_limited(const Twin& twin, const std::vector<SteadyStateRun>& r
   found.contacts = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
   found.judged_by_contacts = judged_by_contacts(twin, found.contacts);
   if (twin.options().only.empty())
-    found.limited = noise_limited(twin, fit.names, fit.scatter, found.contacts);
+    found.limited = noise_limited(twin, fit.names, fit.scatter, found);
   std::vector<std::string> kept;
   for (const std::string& name : fit.names) {
     if (std::none_of(found.limited.begin(), found.limited.end(),

@@ -66,10 +66,10 @@ bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle);
 // Standard errors understate a scan's actual error (1.6-2.8x on the default render), so
 // the contacts' reading checks it after the runs (kPlaceableContactError).
 inline constexpr double kPlaceableScanError = 0.0012;
+inline constexpr double kPlaceableScanFound = 0.99;
 // A placed twin's scans whose contacts read a larger error (RMS a coordinate, in grain
 // diameters) than this are said to lean the fit (the default render's read 0.0021 d).
 inline constexpr double kPlaceableContactError = 0.003;
-inline constexpr double kPlaceableScanFound = 0.99;
 bool placeable_packing_at(const TrajectoryReader& run, std::int64_t cycle);
 
 struct CalibrateOptions {

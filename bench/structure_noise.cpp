@@ -2,10 +2,11 @@
 // (structure_noise_effect, as calibrate's scan-noise check moves them; docs/CALIBRATION.md,
 // "Measured with the contacts' error"): the window means of the bulk and height packing
 // fractions and of the coordination, with every position moved by a normal error of the
-// given RMS across the slices (x, y) and along z, minus as measured. One draw per seed.
+// given RMS across the slices (x, y) and along z, minus as measured (printed after the
+// value as measured). One draw per seed.
 //
 //   structure_noise RUN.h5 --window 1:3 --error 6.96,15.1 (um) --radius 2.5 (mm)
-//                   --grains 3000 [--seed 1]
+//                   --grains 3000 [--seed 1] [--gap 0.02 (the contact gap, d)]
 
 #include <cstdio>
 #include <string>
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   double across = 0, along_z = 0;
   KnownGrains known;
   std::uint64_t seed = 1;
+  StructureOptions structure;
   const bool ok = bench::parse_options(
       argc - 1, argv + 1, "structure_noise",
       {{"--window",
@@ -38,12 +40,15 @@ int main(int argc, char** argv) {
         }},
        {"--radius", [&](const std::string& s) { known.radius = std::stod(s) * 1e-3; }},
        {"--grains", [&](const std::string& s) { known.count = std::stoull(s); }},
-       {"--seed", [&](const std::string& s) { seed = std::stoull(s); }}});
+       {"--seed", [&](const std::string& s) { seed = std::stoull(s); }},
+       {"--gap", [&](const std::string& s) { structure.contact_gap = std::stod(s); }}});
   if (!ok || !known.radius) return 2;
   const TrajectoryReader run(argv[1]);
   const Eigen::Vector3d sigma =
       Eigen::Vector3d(across, across, along_z) * 1e-6 / metres_per_length(run);
-  const SteadyState effect = structure_noise_effect(run, window, sigma, {}, known, seed);
+  const SteadyState effect = structure_noise_effect(run, window, sigma, structure, known, seed);
+  const SteadyState as_measured =
+      window_means(observable_series(run, {}, structure, known, window), window);
   for (const char* name : {"bulk_packing_fraction", "coordination", "height_packing_fraction"})
-    std::printf("%s %+.5g\n", name, effect[name]);
+    std::printf("%s %.6g %+.5g\n", name, as_measured[name], effect[name]);
 }

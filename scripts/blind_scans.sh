@@ -6,12 +6,15 @@
 # scans), and again with the DEM's wall force read beside the scans (--readings; the twin's
 # runs reused). Prints one line per case and writes OUT/blind_scans.csv.
 #
-#   scripts/blind_scans.sh OUT PROTOCOL.toml MU:SEED [MU:SEED ...]
+#   [RENDER="--diameter-px 16 ..."] scripts/blind_scans.sh OUT PROTOCOL.toml MU:SEED [MU:SEED ...]
 #
-# A second call reuses what the first finished (each file is written whole or not at all).
+# RENDER: `granmem render` options for another scanner than the default render. A second
+# call reuses what the first finished (each file is written whole or not at all), a
+# pseudo-experiment already in OUT/sSEED/pseudo.h5 too.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-[ $# -ge 3 ] || { sed -n 2,11p "$0"; exit 2; }
+[ $# -ge 3 ] || { sed -n 2,13p "$0"; exit 2; }
+read -r -a render <<< "${RENDER:-}"
 out=$(realpath -m "$1") protocol=$(realpath "$2")
 shift 2
 granmem=$root/build/app/granmem
@@ -27,7 +30,7 @@ for case in "$@"; do
     --threads 2 --out pseudo.h5 > sim.log 2>&1
   for f in $frames; do
     [ -f "scan$f.tif" ] || "$granmem" render pseudo.h5 --frame "$f" --seed $((f + 5)) \
-      --out "scan$f.tif" > /dev/null
+      "${render[@]}" --out "scan$f.tif" > /dev/null
     [ -f "det/scan$f.h5" ] || "$granmem" track "scan$f.tif" --diameter 5mm --first-cycle "$f" \
       --detections det --out "det/track$f.h5" > "det/track$f.txt" 2>&1
   done

@@ -5,8 +5,9 @@ share"): by PULL_XY_UM and PULL_Z_UM per unit vector to each neighbour, weighted
 exp(-gap / (WIDTH d)) (WIDTH 0.05 by default). CYCLE: the one frame moved (the others
 exact: a placed twin started there starts from a scan's errors while the window's
 observables stay the DEM's, "The wall's force read beside the scans"), or "all".
+--shift X,Y,Z (um): every centre moved by it too (a registration's offset).
 Usage: /usr/bin/python3 scripts/placed_frame_noise.py RUN.h5 OUT.h5 CYCLE|all ACROSS_UM ALONG_Z_UM SEED
-           [PULL_XY_UM PULL_Z_UM [WIDTH]]"""
+           [PULL_XY_UM PULL_Z_UM [WIDTH]] [--shift X,Y,Z]"""
 import shutil
 import sys
 
@@ -40,11 +41,17 @@ def as_scanned(x, diameter, noise, pull, rng, width=0.05):
 
 
 def main():
-    src, dst, which = sys.argv[1], sys.argv[2], sys.argv[3]
-    across, along_z, seed = float(sys.argv[4]), float(sys.argv[5]), int(sys.argv[6])
-    pull = np.array([float(sys.argv[7]), float(sys.argv[7]), float(sys.argv[8])]) * 1e-6 \
-        if len(sys.argv) > 8 else np.zeros(3)
-    width = float(sys.argv[9]) if len(sys.argv) > 9 else 0.05
+    args = sys.argv[1:]
+    shift = np.zeros(3)
+    if "--shift" in args:
+        k = args.index("--shift")
+        shift = np.array([float(v) for v in args[k + 1].split(",")]) * 1e-6
+        del args[k:k + 2]
+    src, dst, which = args[0], args[1], args[2]
+    across, along_z, seed = float(args[3]), float(args[4]), int(args[5])
+    pull = np.array([float(args[6]), float(args[6]), float(args[7])]) * 1e-6 \
+        if len(args) > 7 else np.zeros(3)
+    width = float(args[8]) if len(args) > 8 else 0.05
     shutil.copy(src, dst)
     rng = np.random.default_rng(seed)
     with h5py.File(dst, "r+") as f:
@@ -58,10 +65,12 @@ def main():
         sigma = np.array([across, across, along_z]) * 1e-6 * SCALE[unit]
         for k in frames:
             x = position[k]
-            position[k] = as_scanned(x, diameter, sigma, pull * SCALE[unit], rng, width)
+            position[k] = as_scanned(x, diameter, sigma, pull * SCALE[unit], rng, width) \
+                + shift * SCALE[unit]
     print(f"{dst}: {len(frames)} frame(s) ({x.shape[0]} grains) moved by {across}, {along_z} um"
           + (f", pulled {pull[0] * 1e6:.3g}, {pull[2] * 1e6:.3g} um towards neighbours"
-             if pull.any() else ""))
+             if pull.any() else "")
+          + (f", shifted by {', '.join(f'{v * 1e6:.3g}' for v in shift)} um" if shift.any() else ""))
 
 
 if __name__ == "__main__":

@@ -201,6 +201,35 @@ inline LocateMatch match_locate(const Detections& d, const Table& truth,
   return r;
 }
 
+// How much longer the detections read the distances of touching neighbours than they are:
+// the mean over matched interior pairs whose true centres are within `gap` of touching
+// (distances scaled to x voxels), and how many.
+struct NeighbourDistance {
+  double offset = 0;  // voxels along x; < 0: read too close
+  std::size_t pairs = 0;
+};
+inline NeighbourDistance touching_distance_offset(const LocateMatch& m,
+                                                  const Eigen::Vector3d& voxel_size,
+                                                  double gap = 0.02) {
+  const Eigen::Vector3d scale = voxel_size / voxel_size.x();
+  NeighbourDistance r;
+  double sum = 0;
+  for (std::size_t i = 0; i < m.truth.size(); ++i) {
+    if (m.edge[i] || m.of_grain[i] < 0) continue;
+    for (std::size_t j = i + 1; j < m.truth.size(); ++j) {
+      if (m.edge[j] || m.of_grain[j] < 0) continue;
+      const double truth = (m.truth[i] - m.truth[j]).cwiseProduct(scale).norm();
+      if (truth > (1 + gap) * m.diameter) continue;
+      const Eigen::Vector3d a = m.detected[std::size_t(m.of_grain[i])];
+      const Eigen::Vector3d b = m.detected[std::size_t(m.of_grain[j])];
+      sum += (a - b).cwiseProduct(scale).norm() - truth;
+      ++r.pairs;
+    }
+  }
+  if (r.pairs) r.offset = sum / double(r.pairs);
+  return r;
+}
+
 // The true grains touching a neighbour through their hole (hole_contacts.hpp): centres
 // within 2 % of a diameter of touching, radii 0.5 (the packings' diameter is 1).
 inline std::vector<std::uint8_t> true_hole_contacts(const Table& truth, const LocateMatch& m,

@@ -253,6 +253,28 @@ TEST(Locate, FittedAxesBeatTheLabsEstimate) {
   EXPECT_LT(fitted.median(), 0.75 * lab.median());
 }
 
+TEST(Locate, TouchingNeighboursAreNotReadCloser) {
+  // The image of two touching grains is the sum of their blurred grain fractions; a model
+  // that multiplies what they leave clear reads the rims they share too bright, and each fit
+  // then moves its grain towards its neighbours: touching pairs read ~0.01 voxel close
+  // (docs/BENCHMARKS.md, "The misfit's direction"): -0.0081 voxel on these 268 pairs. With
+  // the neighbours seen through the exactly blurred image and added, +0.0046 (the mean of
+  // 268 carries +-0.0017 of the centres' own error; on 73,552 pairs of a 2,500-grain render
+  // +0.0014).
+  PackingScan scan = packing_scan(220, kPhi, 12, 1.5, 12);
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  LocateOptions o;
+  o.diameter = 12;
+  const Eigen::Vector3d vs = *scan.options.voxel_size;
+  const testing::LocateMatch m = testing::match_locate(locate(stack, o), truth, vs);
+  const testing::NeighbourDistance near = testing::touching_distance_offset(m, vs);
+  std::cout << near.pairs << " touching pairs read " << near.offset << " voxel longer\n";
+  ASSERT_GT(near.pairs, 100u);
+  EXPECT_GT(near.offset, -0.004);
+  EXPECT_LT(near.offset, 0.007);
+}
+
 TEST(Locate, AxesUnderABlurWiderThanTheHoleAlongZ) {
   // PSF 1.0 / 1.0 / 1.5 voxel on slices 1.5x coarser: the blur along z, 2.25 voxels of x,
   // is wider than the hole's radius (1.8). The model fits' radius runs ~1 voxel small

@@ -63,10 +63,12 @@ struct GrainResiduals {
       for (int l = 0; l < count; ++l) {
         const auto k = std::size_t(first + l);
         const double keep = clear ? window->clear[k] : 1.0;
-        const double dark = 1 - (1 - lanes.value[l]) * keep;  // grain, ours or a neighbour's
+        // Grain, ours or a neighbour's.
+        const double dark =
+            window->additive ? lanes.value[l] + 1 - keep : 1 - (1 - lanes.value[l]) * keep;
         residuals[k] = b - (b - g) * dark - window->intensity[k];
         if (!jacobian) continue;
-        const double scale = -(b - g) * keep;  // d residual / d M
+        const double scale = -(b - g) * (window->additive ? 1.0 : keep);  // d residual / d M
         auto J = [&](int p) -> double& { return jacobian[std::size_t(p) * std::size_t(n) + k]; };
         J(0) = scale * lanes.d_centre[0][l];
         J(1) = scale * lanes.d_centre[1][l];

@@ -249,6 +249,8 @@ class GrainLocator {
       // a voxel; whole windows are ~8x the inner ones.
       const std::size_t every = std::max<std::size_t>(1, known.ids.size() / 24);
       radius_shortfall_ = radius_shortfall(known, every, blur, axis_options);
+      blur.shortfall = radius_shortfall_;
+      blur_ = blur;
     }
     for (std::size_t k = 0; k < known.ids.size(); ++k) {
       const HoleAxisFit& r = refits[k];
@@ -257,6 +259,58 @@ class GrainLocator {
         f.sphere.axis = r.axis;
         f.axis_sigma = r.sigma;
       }
+    }
+  }
+
+  // A last model fit of every grain's centre with its neighbours seen as the scan draws
+  // them: through the exactly blurred image at the scan's blur, their radius corrected,
+  // their grain fractions added to the grain's own.
+  void refit_centres() {
+    if (!blur_.sampled) return;
+    const Neighbours known = neighbours(true);
+    std::vector<GrainFit> fits(known.ids.size());
+    const double wide = std::max(blur_.across, blur_.along_z);
+#pragma omp parallel
+    {
+      GrainWindow window;
+      std::vector<HoledSphere> near;
+#pragma omp for schedule(dynamic, 16)
+      for (std::size_t k = 0; k < known.ids.size(); ++k) {
+        const HoledSphere& s = grains_[known.ids[k]].fit.sphere;
+        const Eigen::Vector3d reach = window_reach(s);
+        near.clear();
+        known.grid.near(s.centre, 2, [&](std::size_t j) {
+          HoledSphere other = grains_[known.ids[j]].fit.sphere;
+          other.radius += blur_.shortfall;
+          if (j != k &&
+              (other.centre - s.centre).norm() < reach.maxCoeff() + other.radius + 5 * wide)
+            near.push_back(other);
+        });
+        collect_window(stack_, s.centre, reach, vs_, window);
+        std::vector<double> sum(window.points.size(), 0.0);
+        for (const HoledSphere& other : near)
+          add_blurred_grain_fraction(window.points, other.radius + 5 * wide, other, blur_.across,
+                                     blur_.along_z, sum);
+        for (double& c : sum)
+          c = 1 - c;
+        leave_out_hidden(sum, true, window);
+        window.additive = true;
+        if (window.points.size() <= 20) continue;
+        GrainFitOptions fo;
+        fo.fit_axis = false;  // the refit's axis stands
+        fits[k] = fit_grain(window, s, fo);
+      }
+    }
+    for (std::size_t k = 0; k < known.ids.size(); ++k) {
+      GrainFit& f = grains_[known.ids[k]].fit;
+      const GrainFit& r = fits[k];
+      if (!shaped_like_a_grain(r) ||
+          (r.sphere.centre - f.sphere.centre).norm() > 0.5 * vs_.minCoeff())
+        continue;
+      // The centre only: the radius, whose shortfall the refits measured on these fits, and
+      // the refit's axis stand.
+      f.sphere.centre = r.sphere.centre;
+      f.centre_sigma = r.centre_sigma;
     }
   }
 
@@ -398,14 +452,19 @@ class GrainLocator {
     return Neighbours{std::move(ids), CellGrid(centres, diameter_)};
   }
 
+  // A model fit's window around `s`: three blurs beyond the radius, across the slices and
+  // along z.
+  Eigen::Vector3d window_reach(const HoledSphere& s) const {
+    const double margin = s.radius + 0.5 * vs_.maxCoeff();
+    return {margin + 3 * s.blur, margin + 3 * s.blur, margin + 3 * s.along_z()};
+  }
+
   // One fit of grain i: with the voxels nearer another grain left out or, once the
   // neighbours are known, with them in the model.
   GrainFit fit_one(std::size_t i, bool model_neighbours, const Neighbours& known,
                    GrainWindow& window, std::vector<const HoledSphere*>& near) const {
     const HoledSphere& s = grains_[i].start;
-    // Three blurs beyond the radius, across the slices and along z.
-    const double margin = s.radius + 0.5 * vs_.maxCoeff();
-    const Eigen::Vector3d reach(margin + 3 * s.blur, margin + 3 * s.blur, margin + 3 * s.along_z());
+    const Eigen::Vector3d reach = window_reach(s);
     near.clear();
     known.grid.near(s.centre, 2, [&](std::size_t k) {
       const HoledSphere& other = grains_[known.ids[k]].start;
@@ -574,6 +633,7 @@ class GrainLocator {
   const double diameter_, radius_, hole_;
   // How much the model fits' radius runs small (radius_shortfall()); 0 without refits.
   double radius_shortfall_ = 0;
+  AxisBlur blur_;  // the scan's, sampled by refit_axes()
   CandidateOptions candidate_options_;
   std::vector<Candidate> grains_;
 };
@@ -628,6 +688,7 @@ Detections locate(Stack stack, const LocateOptions& o, LocateSummary* summary) {
   locator.fit();
   begin_stage(o, "hole axes");
   locator.refit_axes();
+  locator.refit_centres();
   sum.seconds_fits = lap();
   Detections d = locator.detections(sum);
   sum.seconds = sum.seconds_illumination + sum.seconds_candidates + sum.seconds_fits + lap();

@@ -10,14 +10,16 @@ namespace granmem {
 
 // The voxels around one grain: physical positions, normalised intensities (fluid 1,
 // grain 0) and, optionally, how much of each the neighbouring grains leave clear, 1 where
-// no neighbour reaches: for the model fits (fit_grain) prod (1 - M_neighbour), for the
-// axis refit (fit_hole_axis) 1 - sum M_neighbour, their blurred grain fractions added (the
-// blur is linear and the grains do not overlap; the product leaves the overlapping blurred
-// rims of grains stacked along a wide blur too bright and tilted the refit's axes).
+// no neighbour reaches: prod (1 - M_neighbour), or, `additive`, 1 - sum M_neighbour, their
+// blurred grain fractions added to the grain's own (the blur is linear and the grains do
+// not overlap: the scan's image; the product leaves the blurred rims that touching grains
+// share too bright, which tilted the axis refit's axes and pulled the model fits' centres
+// towards their neighbours). The axis refit (fit_hole_axis) always adds.
 struct GrainWindow {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> intensity;
   std::vector<double> clear;  // empty: neighbours not modelled
+  bool additive = false;      // for fit_grain: clear is 1 - sum M_neighbour
 };
 
 // A blurred holed sphere fitted to a window by least squares (Ceres' TinySolver,

@@ -57,7 +57,11 @@ struct LocateSummary {
 // along z (hole_axis.hpp), and grains touching a neighbour through their hole are flagged
 // (hole_contacts.hpp); the refits, on the exactly blurred image, also measure how much the
 // model fits' radius runs small (the blurred surface's curvature), and the radii are
-// corrected by it (grains with holes). Works on its own copy of `stack` (normalised,
+// corrected by it (grains with holes). Then each centre is fitted once more with its
+// neighbours seen through the exactly blurred image at the scan's blur, their grain
+// fractions added to its own: the model fits' product of what they leave clear reads the
+// rims touching grains share too bright and pulls each centre towards its neighbours
+// (docs/BENCHMARKS.md). Works on its own copy of `stack` (normalised,
 // illumination.hpp): move a stack in that is not needed after. Positions, radii in the
 // stack's unit when it has a voxel size, else in voxels; anisotropic voxels handled
 // throughout.

@@ -248,8 +248,7 @@ class GrainLocator {
       // 24 grains: a scan's systematic, whose grain-to-grain scatter is a few hundredths of
       // a voxel; whole windows are ~8x the inner ones.
       const std::size_t every = std::max<std::size_t>(1, known.ids.size() / 24);
-      radius_shortfall_ = radius_shortfall(known, every, blur, axis_options);
-      blur.shortfall = radius_shortfall_;
+      blur.shortfall = radius_shortfall(known, every, blur, axis_options);
       blur_ = blur;
     }
     for (std::size_t k = 0; k < known.ids.size(); ++k) {
@@ -332,7 +331,7 @@ class GrainLocator {
       // The model fit's radius runs small (the blur's curvature shift, 0.3 voxel at 12
       // voxels), by what the refits on the exactly blurred image measure (with a hole);
       // for the edge flags, not below the nominal either.
-      const double radius = f.sphere.radius + radius_shortfall_;
+      const double radius = f.sphere.radius + blur_.shortfall;
       const double outer = std::max(radius, radius_);
       const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(outer).cwiseQuotient(vs_);
       const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
@@ -631,9 +630,9 @@ class GrainLocator {
   const LocateOptions& o_;
   const Eigen::Vector3d vs_;
   const double diameter_, radius_, hole_;
-  // How much the model fits' radius runs small (radius_shortfall()); 0 without refits.
-  double radius_shortfall_ = 0;
-  AxisBlur blur_;  // the scan's, sampled by refit_axes()
+  // The scan's blur and how much the model fits' radius runs small (radius_shortfall()),
+  // as refit_axes() sampled them; not sampled (shortfall 0) without refits.
+  AxisBlur blur_;
   CandidateOptions candidate_options_;
   std::vector<Candidate> grains_;
 };

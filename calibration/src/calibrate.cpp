@@ -797,13 +797,23 @@ void add_protocol(JsonObject& j, const Twin& twin) {
   j["settings"] = twin.settings();
 }
 
-std::vector<SteadyStateRun> twin_steady_states(const Twin& twin,
-                                               const std::vector<FrictionRunSpec>& specs) {
+// The twin's runs' steady states. `position_noise` (m, along x, y and z): the scans'
+// locating error, given to every run's positions before their structure is measured, each
+// run its own draws.
+std::vector<SteadyStateRun> twin_steady_states(
+    const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+    const Eigen::Vector3d& position_noise = Eigen::Vector3d::Zero()) {
   std::vector<SteadyStateRun> runs;
   for (const FrictionRunSpec& spec : specs) {
     const TrajectoryReader r(twin.path(spec));
-    runs.push_back(
-        {spec.mu_s, spec.seed, steady_state(r, cycle_observables(r, twin.observe)), spec.mu_r});
+    PositionNoise noise;
+    if (!position_noise.isZero()) {
+      noise.sigma = position_noise / metres_per_length(r);
+      noise.seed = fnv1a(&spec.mu_s, sizeof spec.mu_s,
+                         fnv1a(&spec.mu_r, sizeof spec.mu_r, fnv1a(&spec.seed, sizeof spec.seed)));
+    }
+    const SteadyState state = steady_state(r, cycle_observables(r, twin.observe), {}, {}, noise);
+    runs.push_back({spec.mu_s, spec.seed, state, spec.mu_r});
   }
   return runs;
 }
@@ -949,42 +959,42 @@ ContactLocatingError contacts_locating_error(const Twin& twin,
                                       2 * *known.radius);
 }
 
-// An observable from positions that the scans' own locating noise moves by more than a
-// share of one packing's scatter: the twin's positions are exact, so it would pull the fit
-// by the scans' noise, not by friction (a contact count within a 2 % gap, at a locating
-// error of 1 % of a diameter). Measured by moving the experiment's positions by their
-// error once more: where the scans' contacts give it (a poured twin), their actual error, and the
-// observable is left out where that moves it by more than one packing's scatter (the
-// experiment's own realization, which the interval already carries); elsewhere by locate's
-// standard errors, which a scan's actual error exceeds 2-3x (docs/BENCHMARKS.md), so by a
-// quarter of a scatter (the effects grow as sigma^2: 1-2 scatters at the actual error).
-// The rotation likewise, by tilting its axes once more, but where the twin's axes get the
-// same noise only its size's error, ~10 % (docs/BENCHMARKS.md), can bias the fit: ~20 % of
-// the noise's part where that part grows as sigma^2 (a rotation the noise dominates), less
-// where it grows more slowly; so the rotation is left out where kModelledNoise of the move
-// could exceed one packing's scatter (the noise then most of what is measured). Without
-// noise in the twin's axes (--axis-noise 0) it is judged as the positions are by their
-// standard errors.
+// An observable the scans' own noise moves by more than a share of one packing's scatter
+// pulls the fit by the noise, not by friction (a contact count within a 2 % gap, at a
+// locating error of 1 % of a diameter). Measured by moving the experiment's positions by
+// their error once more (its axes by tilting them once more). Where the twin gets the same
+// noise (its positions the error the scans' contacts read, its axes their axis error) only
+// the noise's size's error can bias the fit: ~10 % in the axes' (docs/BENCHMARKS.md), ~20 %
+// of the noise's part where that grows as sigma^2 (the contacts' reading is closer, 1 %,
+// docs/CALIBRATION.md); so such an observable is left out where kModelledNoise of the move
+// could exceed one packing's scatter (the noise then most of what is measured). Where the
+// twin's stay exact (no contacts to read the error from, --axis-noise 0) the positions are
+// judged by locate's standard errors, which a scan's actual error exceeds 2-3x
+// (docs/BENCHMARKS.md), so by a quarter of a scatter (the effects grow as sigma^2: 1-2
+// scatters at the actual error).
 constexpr double kNoiseShare = 0.25;
-constexpr double kContactsNoiseShare = 1.0;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
   std::string name;
   double effect, scatter;
-  bool modelled;        // the twin adds the same noise (the axes')
+  bool modelled;        // the twin adds the same noise (its axes' or its positions')
   bool dropped = true;  // false: kept, as the fit needs more observables than the rest
 };
 
 // What the scans' noise does to the fit: the observables it leaves out, and the contacts'
-// error where it was measured with it.
+// error where it was read (then given to the twin's positions).
 struct ScanNoise {
   std::vector<NoiseLimited> limited;
   ContactLocatingError contacts;
-  bool judged_by_contacts = false;  // the positions moved by the contacts' error
 };
 
 bool read_from_contacts(const ContactLocatingError& e) {
   return std::isfinite(e.across) && std::isfinite(e.along_z);
+}
+
+// The contacts' error along x, y and z, m.
+Eigen::Vector3d position_noise(const ContactLocatingError& e) {
+  return Eigen::Vector3d(e.across, e.across, e.along_z);
 }
 
 double fitted_mu_r(const ObservableFit&) {
@@ -994,26 +1004,13 @@ double fitted_mu_r(const JointObservableFit& f) {
   return f.mu_r;
 }
 
-// Whether the noise check moves the positions by the contacts' error. A placed twin's
-// replicas scatter far less than pours (they share the experiment's packing), so one
-// packing's scatter there is no measure of what the experiment's own realization already
-// puts in the interval: it is judged by the standard errors and the quarter, as measured on
-// placed twins of scans (docs/CALIBRATION.md, session 27).
-bool judged_by_contacts(const Twin& twin, const ContactLocatingError& contacts) {
-  return read_from_contacts(contacts) && twin.options().preparation != TwinPreparation::experiment;
-}
-
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
                                         const std::vector<double>& scatter,
                                         const ScanNoise& noise) {
-  Eigen::Vector3d e = twin.errors.position;
-  double share = kNoiseShare;
-  if (noise.judged_by_contacts) {
-    const ContactLocatingError& contacts = noise.contacts;
-    e = Eigen::Vector3d(contacts.across, contacts.across, contacts.along_z) /
-        metres_per_length(twin.experiment());
-    share = kContactsNoiseShare;
-  }
+  const bool positions_modelled = read_from_contacts(noise.contacts);
+  const Eigen::Vector3d e =
+      positions_modelled ? position_noise(noise.contacts) / metres_per_length(twin.experiment())
+                         : twin.errors.position;
   SteadyState effect;
   if (e.allFinite() && !e.isZero()) {
     effect =
@@ -1030,27 +1027,34 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   std::vector<NoiseLimited> limited;
   for (std::size_t k = 0; k < names.size(); ++k) {
     const bool rotation_k = names[k] == "rot_disp";
-    const bool modelled = rotation_k && twin.observe.axis_noise > 0;
+    const bool modelled = rotation_k ? twin.observe.axis_noise > 0 : positions_modelled;
     const double d = rotation_k ? rotation : effect[names[k]];
-    if (std::isfinite(d) && (modelled     ? kModelledNoise * std::abs(d) > scatter[k]
-                             : rotation_k ? std::abs(d) > kNoiseShare * scatter[k]
-                                          : std::abs(d) > share * scatter[k]))
+    if (std::isfinite(d) &&
+        std::abs(d) * (modelled ? kModelledNoise : 1) > (modelled ? 1 : kNoiseShare) * scatter[k])
       limited.push_back({names[k], d, scatter[k], modelled});
   }
   return limited;
 }
 
-// The fit again without the observables the scans' noise moves, unless they were chosen
-// with --only; `fewest`: the observables the fit needs. The contacts' error is read against
-// the run nearest the first fit.
-template <class Fit, class Refit>
-Fit without_noise_limited(const Twin& twin, const std::vector<SteadyStateRun>& runs, Fit fit,
-                          Refit refit, std::size_t fewest, ScanNoise* noise) {
+// The twin's runs fitted to the experiment, as a scan would see them: where the scans'
+// contacts give their locating error (read against the run nearest a first fit of the runs'
+// exact positions), the runs' positions are given it before their structure is measured,
+// and the fit is made again; then without the observables the scans' noise still moves,
+// unless they were chosen with --only. `fewest`: the observables the fit needs. `runs`: the
+// runs' steady states as fitted.
+template <class Fit, class FitTo>
+Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, FitTo fit_to,
+                   std::size_t fewest, std::vector<SteadyStateRun>& runs, ScanNoise* noise) {
+  const std::vector<std::string>& only = twin.options().only;
+  runs = twin_steady_states(twin, specs);
+  Fit fit = fit_to(runs, only);
   ScanNoise found;
   found.contacts = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
-  found.judged_by_contacts = judged_by_contacts(twin, found.contacts);
-  if (twin.options().only.empty())
-    found.limited = noise_limited(twin, fit.names, fit.scatter, found);
+  if (read_from_contacts(found.contacts)) {
+    runs = twin_steady_states(twin, specs, position_noise(found.contacts));
+    fit = fit_to(runs, only);
+  }
+  if (only.empty()) found.limited = noise_limited(twin, fit.names, fit.scatter, found);
   std::vector<std::string> kept;
   for (const std::string& name : fit.names) {
     if (std::none_of(found.limited.begin(), found.limited.end(),
@@ -1061,33 +1065,33 @@ Fit without_noise_limited(const Twin& twin, const std::vector<SteadyStateRun>& r
   for (NoiseLimited& l : found.limited)
     l.dropped = refit_without;
   if (noise) *noise = found;
-  return refit_without ? refit(kept) : fit;
+  return refit_without ? fit_to(runs, kept) : fit;
 }
 
-ObservableFit steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
-                               ScanNoise* noise = nullptr) {
-  const CalibrateOptions& o = twin.options();
-  auto fit = [&](const std::vector<std::string>& names) {
-    return fit_friction_to_steady_state(twin.measured_steady_state(), runs,
-                                        observable_fit_options(o), names);
+ObservableFit steady_state_fit(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
+                               std::vector<SteadyStateRun>& runs, ScanNoise* noise = nullptr) {
+  auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
+    return fit_friction_to_steady_state(twin.measured_steady_state(), r,
+                                        observable_fit_options(twin.options()), names);
   };
-  return without_noise_limited(twin, runs, fit(o.only), fit, 1, noise);
+  return fit_as_scanned<ObservableFit>(twin, specs, fit_to, 1, runs, noise);
 }
 
-JointObservableFit joint_steady_state_fit(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+JointObservableFit joint_steady_state_fit(const Twin& twin,
+                                          const std::vector<FrictionRunSpec>& specs,
+                                          std::vector<SteadyStateRun>& runs,
                                           ScanNoise* noise = nullptr) {
-  const CalibrateOptions& o = twin.options();
-  auto fit = [&](const std::vector<std::string>& names) {
-    return fit_frictions_to_steady_state(twin.measured_steady_state(), runs,
-                                         observable_fit_options(o), names);
+  auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
+    return fit_frictions_to_steady_state(twin.measured_steady_state(), r,
+                                         observable_fit_options(twin.options()), names);
   };
-  return without_noise_limited(twin, runs, fit(o.only), fit, 2, noise);
+  return fit_as_scanned<JointObservableFit>(twin, specs, fit_to, 2, runs, noise);
 }
 
 // The report's lines on the observables left out, and why; their names for summary.json.
 void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObject& j) {
   std::vector<std::string> names;
-  const bool contacts = noise.judged_by_contacts;
+  const bool contacts = read_from_contacts(noise.contacts);
   for (const NoiseLimited& l : noise.limited) {
     const bool rotation = l.name == "rot_disp";
     report << std::setprecision(3) << "  note: " << l.name
@@ -1095,9 +1099,10 @@ void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObje
            << (rotation ? "axis" : "locating") << " noise"
            << (!rotation && contacts ? " (their contacts' error)" : "") << " moves it by "
            << l.effect << " (one packing's scatter " << l.scatter << ")"
-           << (l.modelled ? ", more than the twin's tilted axes model"
-               : rotation ? " and the twin's axes are exact"
-                          : " and the twin's positions are exact")
+           << (!l.modelled ? (rotation ? " and the twin's axes are exact"
+                                       : " and the twin's positions are exact")
+               : rotation  ? ", more than the twin's tilted axes model"
+                           : ", more than the twin's moved positions model")
            << (l.dropped ? " (--only keeps it)\n" : "\n");
     if (l.dropped) names.push_back(l.name);
   }
@@ -1119,7 +1124,8 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
            << twin.errors.position.head<2>().norm() / std::sqrt(2.0) * stored << " and "
            << twin.errors.position.z() * stored << " um";
   }
-  report << "\n";
+  report << "; the twin's positions were given this error before their structure was "
+            "measured\n";
   const double rms = std::sqrt((2 * e.across * e.across + e.along_z * e.along_z) / 3);
   const double diameter = 2 * twin.known_grains().radius.value_or(std::nan(""));
   if (twin.options().preparation == TwinPreparation::experiment &&
@@ -1134,6 +1140,7 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
   c["along_z_um"] = e.along_z * um;
   c["contact_offset_um"] = e.offset * um;
   c["distances"] = e.pairs;
+  c["given_to_twin"] = true;
   j["locating_error_from_contacts"] = c;
 }
 
@@ -1145,19 +1152,20 @@ bool interior(double mu, const std::vector<double>& simulated) {
 
 // The design's fit, as the friction (pair) refined packings are added at, and its line.
 std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
-                                                   const std::vector<SteadyStateRun>& runs) {
+                                                   const std::vector<FrictionRunSpec>& specs) {
   const CalibrateOptions& o = twin.options();
   std::ostringstream line;
   line << std::setprecision(3) << "the design's fit: ";
   FrictionRunSpec at;
   ScanNoise noise;
+  std::vector<SteadyStateRun> runs;
   if (o.joint()) {
-    const JointObservableFit f = joint_steady_state_fit(twin, runs, &noise);
+    const JointObservableFit f = joint_steady_state_fit(twin, specs, runs, &noise);
     at = {three_digits(f.mu_s), 0, three_digits(f.mu_r)};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << "), mu_r = " << f.mu_r << " (" << f.mu_r_ci95[0] << " - " << f.mu_r_ci95[1] << ")";
   } else {
-    const ObservableFit f = steady_state_fit(twin, runs, &noise);
+    const ObservableFit f = steady_state_fit(twin, specs, runs, &noise);
     at = {three_digits(f.mu_s), 0};
     line << "mu_s = " << f.mu_s << " (95% interval " << f.mu_s_ci95[0] << " - " << f.mu_s_ci95[1]
          << ")";
@@ -1174,7 +1182,7 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
 std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunSpec> specs,
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  auto [at, line] = design_fit(twin, twin_steady_states(twin, specs));
+  auto [at, line] = design_fit(twin, specs);
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";
     twin.say(line);
@@ -1201,10 +1209,10 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
 void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                       CalibrateSummary& s, std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
   const SteadyState measured = twin.measured_steady_state();
   ScanNoise noise;
-  const ObservableFit fit = steady_state_fit(twin, runs, &noise);
+  std::vector<SteadyStateRun> runs;
+  const ObservableFit fit = steady_state_fit(twin, specs, runs, &noise);
   const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed()};
   const FrictionRunSpec best = compared_run(twin, specs, at_fit, [&](const FrictionRunSpec& r) {
     return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];
@@ -1269,9 +1277,9 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
 void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, CalibrateSummary& s,
                std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  const std::vector<SteadyStateRun> runs = twin_steady_states(twin, specs);
   ScanNoise noise;
-  const JointObservableFit fit = joint_steady_state_fit(twin, runs, &noise);
+  std::vector<SteadyStateRun> runs;
+  const JointObservableFit fit = joint_steady_state_fit(twin, specs, runs, &noise);
   const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed(), three_digits(fit.mu_r)};
   // Inside the joint 95 % region: (ln mu_s, ln mu_r) within chi2(2 dof) = 5.99 of the fit.
   const Eigen::Matrix2d covariance = Eigen::Map<const Eigen::Matrix2d>(fit.log_covariance.data());

@@ -212,17 +212,15 @@ std::string steady_state_label(const std::string& name) {
 
 namespace {
 
-// The observables from positions, frame by frame, each position moved by a normal error of
-// `jitter` along x, y and z (the run's length unit; zero: as stored).
+// The observables from positions, frame by frame, each position moved by `noise`.
 void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
                           const StructureOptions& structure, const KnownGrains& known,
-                          CycleRange cycles,
-                          const Eigen::Vector3d& jitter = Eigen::Vector3d::Zero(),
-                          std::uint64_t seed = 1) {
+                          CycleRange cycles, const PositionNoise& noise) {
   const auto in_range = [&](std::int64_t c) {
     return cycles.second == 0 || (c >= cycles.first && c <= cycles.second);
   };
-  Random random(seed);
+  Random random(noise.seed);
+  const Eigen::Vector3d& jitter = noise.sigma;
   ObservableSeries::Entry packing{"bulk_packing_fraction", {}, {}, true},
       coordination{"coordination", {}, {}, true},
       from_height{"height_packing_fraction", {}, {}, true};
@@ -256,13 +254,13 @@ void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
 
 ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
                                    const StructureOptions& structure, const KnownGrains& known,
-                                   CycleRange cycles) {
+                                   CycleRange cycles, const PositionNoise& noise) {
   ObservableSeries s;
   if (std::any_of(observed.mean_rot_disp.begin(), observed.mean_rot_disp.end(),
                   [](double v) { return std::isfinite(v); })) {
     s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
   }
-  add_structure_series(s, run, structure, known, cycles);
+  add_structure_series(s, run, structure, known, cycles, noise);
   // The store's own, under the names the fit knows them by: the wall force at the end of
   // each cycle is the packing's lateral stress with the wall back at its start.
   const std::pair<const char*, const char*> stored[] = {
@@ -312,8 +310,8 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
                                    const Eigen::Vector3d& sigma, const StructureOptions& structure,
                                    const KnownGrains& known, std::uint64_t seed) {
   ObservableSeries plain, jittered;
-  add_structure_series(plain, run, structure, known, window);
-  add_structure_series(jittered, run, structure, known, window, sigma, seed);
+  add_structure_series(plain, run, structure, known, window, {});
+  add_structure_series(jittered, run, structure, known, window, {sigma, seed});
   SteadyState effect = window_means(jittered, window);
   const SteadyState as_measured = window_means(plain, window);
   for (std::size_t k = 0; k < effect.values.size(); ++k)
@@ -323,8 +321,9 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
 }
 
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure, const KnownGrains& known) {
-  return window_means(observable_series(run, observed, structure, known, observed.window),
+                         const StructureOptions& structure, const KnownGrains& known,
+                         const PositionNoise& noise) {
+  return window_means(observable_series(run, observed, structure, known, observed.window, noise),
                       observed.window);
 }
 

@@ -136,9 +136,9 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
     # Scans in voxels of 0.1 mm whose centres err by 0.2 mm (4 % of a diameter) while their
     # standard errors say 1 um: the touching neighbours' spread reads the actual error. Their
     # standard errors being fine, the twin is placed from them by default, and the contacts,
-    # read against its run, say that it leans; poured, the noise check, measured with the
-    # contacts' error, leaves out the height the noise moves (with the standard errors alone
-    # it would keep it, as for the scans located to 1 um above).
+    # read against its run, say that it leans. The twin's positions are given the error the
+    # contacts read before their structure is measured, so the height the noise moves is
+    # fitted as the scans see it, not left out; poured, the fit holds the true friction.
     voxel, sigma = 1e-4, 2e-4
     tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
     lo, hi = granmem.read_run(experiment)["box"]
@@ -161,9 +161,13 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
         placed = deposit == "auto"
         assert summary["deposit"] == ("experiment" if placed else "each")
         assert ("more than 0.003 d: the twin's packings settle denser" in fit["report"]) == placed
-    assert "height_packing_fraction" in summary["left_out_for_scan_noise"]
-    assert "height_packing_fraction left out: the scans' own locating noise (their contacts' " \
-        "error) moves it by" in fit["report"]
+        assert contacts["given_to_twin"]
+        assert "the twin's positions were given this error before their structure was " \
+            "measured" in fit["report"]
+        assert "height_packing_fraction" in summary["observables"]
+        assert summary["left_out_for_scan_noise"] == []
+    lo, hi = fit["mu_s_ci95"]
+    assert lo < 0.2 < hi and hi / lo < 3
 
 
 def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):

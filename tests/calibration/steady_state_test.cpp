@@ -55,11 +55,17 @@ Trajectories cubic_run() {
   return run;
 }
 
-class SteadyStateTest : public testing::TempDirTest {};
+class SteadyStateTest : public testing::TempDirTest {
+ protected:
+  // cubic_run() written to the store and read back.
+  TrajectoryReader cubic_store() {
+    write_trajectories(path("run.h5"), cubic_run());
+    return TrajectoryReader(path("run.h5"));
+  }
+};
 
 TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservables) {
-  write_trajectories(path("run.h5"), cubic_run());
-  const TrajectoryReader run(path("run.h5"));
+  const TrajectoryReader run = cubic_store();
   ObservableOptions o;
   o.window = {3, 4};
   const SteadyState s = steady_state(run, cycle_observables(run, o));
@@ -89,8 +95,7 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
 // two frames is measured as the Rice-distributed angle between two noisy axes, whose mean
 // square is kTurn^2 + 4 sigma^2. The same seed gives the same angles.
 TEST_F(SteadyStateTest, AnAxisNoiseAddsToTheRotationsAsAScansError) {
-  write_trajectories(path("run.h5"), cubic_run());
-  const TrajectoryReader run(path("run.h5"));
+  const TrajectoryReader run = cubic_store();
   ObservableOptions o;
   o.window = {1, 4};
   const CycleObservables exact = cycle_observables(run, o);
@@ -158,8 +163,7 @@ TEST_F(SteadyStateTest, GrainsAScanMissedAreCountedInThePackingsHeight) {
 // packing fraction hardly moves (its ends are many grains). No noise, no effect; the seed
 // sets the moves.
 TEST_F(SteadyStateTest, LocatingNoiseOpensContactsButKeepsThePackingsHeight) {
-  write_trajectories(path("run.h5"), cubic_run());
-  const TrajectoryReader run(path("run.h5"));
+  const TrajectoryReader run = cubic_store();
   const CycleRange window{3, 4};
   const SteadyState none = structure_noise_effect(run, window, Eigen::Vector3d::Zero());
   for (double v : none.values)
@@ -177,6 +181,36 @@ TEST_F(SteadyStateTest, LocatingNoiseOpensContactsButKeepsThePackingsHeight) {
   const SteadyState along_z = structure_noise_effect(run, window, Eigen::Vector3d(0, 0, 0.01));
   EXPECT_LT(along_z["coordination"], 0);
   EXPECT_GT(along_z["coordination"], noisy["coordination"]);
+}
+
+// A twin's exact positions given a scan's locating error read the structure such scans
+// read: the contacts within the 2 % gap open by what the noise check measures with the same
+// draws (each bond's gap ~normal with sigma sqrt(2) x 1 % of d: Phi(sqrt 2) = 92.1 % of the
+// 6 stay), while the rotation and the store's own observables, not from positions, stand.
+// Zero noise: the positions as stored.
+TEST_F(SteadyStateTest, PositionsGivenAScansErrorReadTheStructureSuchScansRead) {
+  const TrajectoryReader run = cubic_store();
+  ObservableOptions o;
+  o.window = {3, 4};
+  const CycleObservables observed = cycle_observables(run, o);
+  const SteadyState exact = steady_state(run, observed);
+  EXPECT_EQ(steady_state(run, observed, {}, {}, PositionNoise{}).values, exact.values);
+  const PositionNoise noise{Eigen::Vector3d::Constant(0.01), 7};  // mm: 1 % of d
+  const SteadyState scanned = steady_state(run, observed, {}, {}, noise);
+  const SteadyState effect = structure_noise_effect(run, o.window, noise.sigma, {}, {}, noise.seed);
+  for (const char* name : {"bulk_packing_fraction", "coordination", "height_packing_fraction"})
+    EXPECT_NEAR(scanned[name], exact[name] + effect[name], 1e-12) << name;
+  EXPECT_DOUBLE_EQ(exact["coordination"], 6);
+  // 64 bulk grains a frame: the share over 20 draws, to ~0.004
+  double kept = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed)
+    kept += steady_state(run, observed, {}, {}, {noise.sigma, seed})["coordination"] / (20 * 6);
+  EXPECT_NEAR(kept, 0.921, 0.012);
+  for (const char* name : {"rot_disp", "wall_force_unloaded", "packing_fraction"})
+    EXPECT_EQ(scanned[name], exact[name]) << name;
+  const PositionNoise other_draws{noise.sigma, 8};
+  EXPECT_NE(steady_state(run, observed, {}, {}, other_draws)["coordination"],
+            scanned["coordination"]);
 }
 
 // compare's options (the window and wall distance it pools these observables with),

@@ -109,8 +109,17 @@ struct KnownGrains {
   // side of the beam) would read a looser packing from its height, 1/N per grain missed.
   std::optional<std::size_t> count;
 };
+// A scan's locating error, given to a simulation's exact positions before the observables
+// from positions are measured (as its axes get the scan's axis error): its standard
+// deviation along x, y and z, in the run's length unit, and the seed of its draws. Zero: the
+// positions as stored.
+struct PositionNoise {
+  Eigen::Vector3d sigma = Eigen::Vector3d::Zero();
+  std::uint64_t seed = 1;
+};
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
-                         const StructureOptions& structure = {}, const KnownGrains& known = {});
+                         const StructureOptions& structure = {}, const KnownGrains& known = {},
+                         const PositionNoise& noise = {});
 
 // Cycles, inclusive; (0, 0): every cycle.
 using CycleRange = std::pair<std::int64_t, std::int64_t>;
@@ -128,7 +137,8 @@ struct ObservableSeries {
 };
 ObservableSeries observable_series(const TrajectoryReader& run, const CycleObservables& observed,
                                    const StructureOptions& structure = {},
-                                   const KnownGrains& known = {}, CycleRange cycles = {0, 0});
+                                   const KnownGrains& known = {}, CycleRange cycles = {0, 0},
+                                   const PositionNoise& noise = {});
 SteadyState window_means(const ObservableSeries& series, CycleRange window);
 // How far locating noise moves the observables from positions (bulk and height packing
 // fractions, coordination): their window means with every position moved by a further

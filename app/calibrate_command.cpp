@@ -122,14 +122,15 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->check(CLI::IsMember({"pooled", "per-cycle"}));
   cmd->add_option("--observables", args->observables,
                   "displacements: the distribution of end-of-cycle displacements (--summaries); "
-                  "steady-state: the window means of the rotation, the packing fraction from "
+                  "steady-state: the window means of the end-of-cycle displacement and the "
+                  "rotation, the packing fraction from "
                   "the packing's height and in its bulk, the coordination, all from positions, "
                   "and the wall force at full compression and at the cycle's end where the "
                   "experiment has them (docs/CALIBRATION.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"displacements", "steady-state"}));
   cmd->add_option("--only", args->only,
-                  "steady-state: fit only these observables, comma list (rot_disp, "
+                  "steady-state: fit only these observables, comma list (dr, rot_disp, "
                   "bulk_packing_fraction, coordination, height_packing_fraction, "
                   "packing_fraction, wall_force_full_compression, wall_force_unloaded); "
                   "default all the experiment has, the lid's packing_fraction left out where "

@@ -286,11 +286,14 @@ ObservableOptions observable_options(const CalibrateOptions& o, const Trajectory
 
 // The experiment's observables, measured in its own container, open at the top as the
 // twin's: the lid moves, so grains are left out near the floor and the side walls only.
-// `extra_axis_noise`: rad, the experiment's axes tilted once more (its axes carry their own).
-CycleObservables measured_observables(const TrajectoryReader& experiment, ObservableOptions o,
-                                      double extra_axis_noise = 0) {
+// `extra_axis_noise`: rad, the experiment's axes tilted once more (its axes carry their own);
+// `extra_position_noise`: m, its positions moved once more.
+CycleObservables measured_observables(
+    const TrajectoryReader& experiment, ObservableOptions o, double extra_axis_noise = 0,
+    const Eigen::Vector3d& extra_position_noise = Eigen::Vector3d::Zero()) {
   o.motion.box.reset();
   o.axis_noise = extra_axis_noise;
+  o.position_noise = extra_position_noise;
   if (const auto& box = experiment.header().box; box && o.motion.wall_distance > 0) {
     o.motion.box = Box{box->lower, Eigen::Vector3d(box->edges(0), box->edges(1), 1e9)};
   }
@@ -841,7 +844,7 @@ void write_steady_state_runs(const fs::path& out, const ObservableFit& fit,
       value[k]->values.push_back(r.state[fit.names[k]]);
   }
   write_csv(t, out / "steady_state_runs.csv",
-            {"the twin's steady state: window means per run (rot_disp in grain diameters, "
+            {"the twin's steady state: window means per run (dr and rot_disp in grain diameters, "
              "wall force in N)"});
 }
 
@@ -971,7 +974,10 @@ ContactLocatingError contacts_locating_error(const Twin& twin,
 // twin's stay exact (no contacts to read the error from, --axis-noise 0) the positions are
 // judged by locate's standard errors, which a scan's actual error exceeds 2-3x
 // (docs/BENCHMARKS.md), so by a quarter of a scatter (the effects grow as sigma^2: 1-2
-// scatters at the actual error).
+// scatters at the actual error). The displacements are judged so too: the twin's stay
+// exact, as a scan's errors in consecutive frames are partly shared (an independent error
+// of the contacts' size moves the mean displacement ~1.8x as far as the scans' own errors
+// do, docs/CALIBRATION.md), so no noise given to the twin would model them.
 constexpr double kNoiseShare = 0.25;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
@@ -1004,6 +1010,13 @@ double fitted_mu_r(const JointObservableFit& f) {
   return f.mu_r;
 }
 
+// The window mean of the per-cycle mean end-of-cycle displacement (the steady state's "dr").
+double window_mean_displacement(const CycleObservables& o) {
+  ObservableSeries s;
+  s.entries.push_back({"dr", o.cycle, o.mean_dr, false});
+  return window_means(s, o.window)["dr"];
+}
+
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
                                         const std::vector<double>& scatter,
                                         const ScanNoise& noise) {
@@ -1012,9 +1025,13 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
       positions_modelled ? position_noise(noise.contacts) / metres_per_length(twin.experiment())
                          : twin.errors.position;
   SteadyState effect;
+  double displacement = std::nan("");
   if (e.allFinite() && !e.isZero()) {
     effect =
         structure_noise_effect(twin.experiment(), twin.observe.window, e, {}, twin.known_grains());
+    const CycleObservables moved = measured_observables(twin.experiment(), twin.observe, 0,
+                                                        e * metres_per_length(twin.experiment()));
+    displacement = window_mean_displacement(moved) - twin.measured_steady_state()["dr"];
   }
   double rotation = std::nan("");
   if (twin.errors.axis > 0 && twin.observe.rotations) {
@@ -1026,9 +1043,11 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   }
   std::vector<NoiseLimited> limited;
   for (std::size_t k = 0; k < names.size(); ++k) {
-    const bool rotation_k = names[k] == "rot_disp";
-    const bool modelled = rotation_k ? twin.observe.axis_noise > 0 : positions_modelled;
-    const double d = rotation_k ? rotation : effect[names[k]];
+    const bool rotation_k = names[k] == "rot_disp", displacement_k = names[k] == "dr";
+    const bool modelled = rotation_k       ? twin.observe.axis_noise > 0
+                          : displacement_k ? false
+                                           : positions_modelled;
+    const double d = rotation_k ? rotation : displacement_k ? displacement : effect[names[k]];
     if (std::isfinite(d) &&
         std::abs(d) * (modelled ? kModelledNoise : 1) > (modelled ? 1 : kNoiseShare) * scatter[k])
       limited.push_back({names[k], d, scatter[k], modelled});
@@ -1099,8 +1118,9 @@ void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObje
            << (rotation ? "axis" : "locating") << " noise"
            << (!rotation && contacts ? " (their contacts' error)" : "") << " moves it by "
            << l.effect << " (one packing's scatter " << l.scatter << ")"
-           << (!l.modelled ? (rotation ? " and the twin's axes are exact"
-                                       : " and the twin's positions are exact")
+           << (!l.modelled ? (rotation         ? " and the twin's axes are exact"
+                              : l.name == "dr" ? " and the twin's displacements are exact"
+                                               : " and the twin's positions are exact")
                : rotation  ? ", more than the twin's tilted axes model"
                            : ", more than the twin's moved positions model")
            << (l.dropped ? " (--only keeps it)\n" : "\n");

@@ -106,8 +106,15 @@ CycleObservables cycle_observables(const TrajectoryReader& run, const Observable
   }
   const RunHeader& measured_header = noisy ? with_axes : h;
   std::mt19937_64 random(1);  // a fixed seed: the same noise for a run each time
+  Random position_random(1);
+  const Eigen::Vector3d position_sigma = options.position_noise / metres;
   auto read = [&](std::size_t t) {
     Frame f = run.read_frame(t);
+    if (!position_sigma.isZero()) {
+      for (Eigen::Index i = 0; i < f.position.rows(); ++i)
+        f.position.row(i) +=
+            position_sigma.cwiseProduct(normal_vector(position_random)).transpose();
+    }
     return noisy ? with_axis_noise(h, std::move(f), options.axis_noise, random) : f;
   };
   std::vector<Eigen::Vector3d> displacement;
@@ -199,6 +206,7 @@ double SteadyState::drift_of(const std::string& name) const {
 
 std::string steady_state_label(const std::string& name) {
   static const std::map<std::string, std::string> labels{
+      {"dr", "end-of-cycle displacement (d)"},
       {"rot_disp", "rotational displacement (d)"},
       {"bulk_packing_fraction", "bulk packing fraction (positions)"},
       {"coordination", "coordination number (positions)"},
@@ -256,6 +264,7 @@ ObservableSeries observable_series(const TrajectoryReader& run, const CycleObser
                                    const StructureOptions& structure, const KnownGrains& known,
                                    CycleRange cycles, const PositionNoise& noise) {
   ObservableSeries s;
+  s.entries.push_back({"dr", observed.cycle, observed.mean_dr, false});
   if (std::any_of(observed.mean_rot_disp.begin(), observed.mean_rot_disp.end(),
                   [](double v) { return std::isfinite(v); })) {
     s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});

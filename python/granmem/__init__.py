@@ -336,7 +336,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
     (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
     window ending there over which the twin's runs are steady): "steady-state" (the default:
-    window means of rotation, packing fraction, coordination, wall force; ``only`` a
+    window means of displacement, rotation, packing fraction, coordination, wall force; ``only`` a
     subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on

@@ -86,12 +86,16 @@ def test_the_axis_noise_is_read_from_the_scans_standard_errors(tmp_path, experim
     assert given["mu_s"] == pytest.approx(auto["mu_s"], rel=1e-6)
     none = granmem.calibrate(scans, tmp_path / "cal", **dict(FIT, axis_noise=0), **TWIN)
     assert none["mu_s"] != auto["mu_s"]
-    # Axes without their errors (another program's tracks): exact in the twin, and said.
+    # Axes without their errors (another program's tracks): exact in the twin, and said;
+    # the same fit as the scans' with the twin's axes exact (both observables kept: the
+    # noise check would leave the scans' rotation out, as their axes carry an error).
     bare = tmp_path / "bare.h5"
     granmem.write_run(tracks.drop(columns=["qw", "qx", "qy", "qz", "axis_error"]), bare,
                       length_unit="m")
     lines = []
-    exact = granmem.calibrate(bare, tmp_path / "cal", progress=lines.append, **FIT, **TWIN)
+    both = dict(FIT, only=["dr", "rot_disp"])
+    exact = granmem.calibrate(bare, tmp_path / "cal", progress=lines.append, **both, **TWIN)
+    none = granmem.calibrate(scans, tmp_path / "cal", **dict(both, axis_noise=0), **TWIN)
     assert exact["mu_s"] == none["mu_s"]
     assert any("carry no standard errors" in r.get("line", "") for r in lines)
 
@@ -100,7 +104,8 @@ def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experime
     # The pseudo-experiment as scans locating centres to 0.1 mm (2 % of a diameter, said
     # by their standard errors), imported in the container's frame. The height of 60 grains
     # is a few grains' tops and bottoms, which such noise moves (the highest of a few noisy
-    # tops is higher) by most of one packing's scatter: the twin, exact, would not see it.
+    # tops is higher) by most of one packing's scatter: the twin, exact, would not see it;
+    # nor the displacements, each the difference of two such positions.
     tracks = granmem.read_tracks(experiment).drop(columns=["qw", "qx", "qy", "qz"])
     lo, hi = granmem.read_run(experiment)["box"]
     rng = np.random.default_rng(3)
@@ -119,7 +124,7 @@ def test_what_the_scans_locating_noise_moves_is_left_out(tmp_path, cli, experime
     noisy = granmem.calibrate(scans(1e-4, "noisy", missed=[5]), tmp_path / "cal",
                               progress=lines.append, **FIT, **TWIN)
     summary = json.loads((tmp_path / "cal" / "summary.json").read_text())
-    assert summary["left_out_for_scan_noise"] == ["height_packing_fraction"]
+    assert summary["left_out_for_scan_noise"] == ["dr", "height_packing_fraction"]
     assert list(summary["observables"]) == ["rot_disp"]
     assert "height_packing_fraction left out: the scans' own locating noise moves it by" \
         in noisy["report"]
@@ -165,7 +170,8 @@ def test_the_scans_contacts_say_their_actual_noise(tmp_path, cli, experiment):
         assert "the twin's positions were given this error before their structure was " \
             "measured" in fit["report"]
         assert "height_packing_fraction" in summary["observables"]
-        assert summary["left_out_for_scan_noise"] == []
+        # the displacements, which the twin's positions' noise does not model, are left out
+        assert summary["left_out_for_scan_noise"] == ["dr"]
     lo, hi = fit["mu_s_ci95"]
     assert lo < 0.2 < hi and hi / lo < 3
 

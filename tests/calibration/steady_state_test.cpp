@@ -8,6 +8,7 @@
 #include "checks.hpp"
 #include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "temp_dir.hpp"
 
@@ -70,9 +71,10 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   o.window = {3, 4};
   const SteadyState s = steady_state(run, cycle_observables(run, o));
   EXPECT_EQ(s.names,
-            (std::vector<std::string>{"rot_disp", "bulk_packing_fraction", "coordination",
+            (std::vector<std::string>{"dr", "rot_disp", "bulk_packing_fraction", "coordination",
                                       "height_packing_fraction", "packing_fraction",
                                       "wall_force_full_compression", "wall_force_unloaded"}));
+  EXPECT_NEAR(s["dr"], 0.01, 1e-12);             // every grain 0.01 mm along x, in diameters
   EXPECT_NEAR(s["rot_disp"], kTurn / 2, 1e-12);  // angle x d/2, in diameters
   EXPECT_NEAR(s["bulk_packing_fraction"], M_PI / 6, 1e-12);
   EXPECT_DOUBLE_EQ(s["coordination"], 6);
@@ -87,6 +89,7 @@ TEST_F(SteadyStateTest, WindowMeansOfTheRotationTheStructureAndTheStoresObservab
   EXPECT_NEAR(s.drift_of("wall_force_full_compression"), 10, 1e-12);
   EXPECT_NEAR(s.drift_of("wall_force_unloaded"), -0.1, 1e-12);
   EXPECT_NEAR(s.drift_of("rot_disp"), 0, 1e-12);
+  EXPECT_NEAR(s.drift_of("dr"), 0, 1e-12);
   EXPECT_NEAR(s.drift_of("height_packing_fraction"), 0, 1e-12);
 }
 
@@ -110,6 +113,26 @@ TEST_F(SteadyStateTest, AnAxisNoiseAddsToTheRotationsAsAScansError) {
     EXPECT_NEAR(r, kTurn / 2, 1e-12);
   EXPECT_EQ(noisy.dr, exact.dr);  // positions are not touched
   EXPECT_EQ(cycle_observables(run, o).rot_disp, noisy.rot_disp);
+}
+
+// A scan's locating error adds to the displacements: each frame's positions moved by sigma
+// along every axis give a displacement an error of sigma sqrt(2) per component, so the mean
+// |dr| of the lattice's uniform 0.01 mm steps under sigma = 0.1 mm is the mean of a
+// noncentral chi with 3 degrees of freedom, s sqrt(8 / pi) (1 + (0.01 / s)^2 / 6), s = sigma
+// sqrt(2): 0.2259 mm (2,048 displacements: to ~1 %). The rotations are untouched.
+TEST_F(SteadyStateTest, ALocatingErrorAddsToTheDisplacementsAsAScansError) {
+  const TrajectoryReader run = cubic_store();
+  ObservableOptions o;
+  o.window = {1, 4};
+  const CycleObservables exact = cycle_observables(run, o);
+  o.position_noise = Eigen::Vector3d::Constant(0.1e-3);  // m
+  const CycleObservables noisy = cycle_observables(run, o);
+  const double s = 0.1 * std::sqrt(2.0);
+  EXPECT_NEAR(summarize(noisy.dr).mean, s * std::sqrt(8 / M_PI) * (1 + std::pow(0.01 / s, 2) / 6),
+              0.008);
+  for (double dr : exact.dr)
+    EXPECT_NEAR(dr, 0.01, 1e-12);
+  EXPECT_EQ(noisy.rot_disp, exact.rot_disp);
 }
 
 // A scan's located radii come out small (blur, threshold): measured at the grains' known

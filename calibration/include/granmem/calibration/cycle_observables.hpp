@@ -33,6 +33,10 @@ struct ObservableOptions {
   // measured rotation): the standard deviation of the axis' tilt in each direction across
   // it. 0: none.
   double axis_noise = 0;
+  // m: a scan's locating error along x, y and z, added to every frame's positions (each
+  // frame its own draws) before the displacements are measured: how far such an error
+  // moves them (calibrate's noise check). Zero: none.
+  Eigen::Vector3d position_noise = Eigen::Vector3d::Zero();
 };
 
 // Lengths in grain diameters.

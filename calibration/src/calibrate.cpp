@@ -802,10 +802,14 @@ void add_protocol(JsonObject& j, const Twin& twin) {
 
 // The twin's runs' steady states. `position_noise` (m, along x, y and z): the scans'
 // locating error, given to every run's positions before their structure is measured, each
-// run its own draws.
+// run its own draws; `displacement_noise` (m): the per-frame error that moves the scans'
+// displacements, given to the positions their displacements are measured from.
 std::vector<SteadyStateRun> twin_steady_states(
     const Twin& twin, const std::vector<FrictionRunSpec>& specs,
-    const Eigen::Vector3d& position_noise = Eigen::Vector3d::Zero()) {
+    const Eigen::Vector3d& position_noise = Eigen::Vector3d::Zero(),
+    const Eigen::Vector3d& displacement_noise = Eigen::Vector3d::Zero()) {
+  ObservableOptions observe = twin.observe;
+  observe.position_noise = displacement_noise;
   std::vector<SteadyStateRun> runs;
   for (const FrictionRunSpec& spec : specs) {
     const TrajectoryReader r(twin.path(spec));
@@ -815,7 +819,7 @@ std::vector<SteadyStateRun> twin_steady_states(
       noise.seed = fnv1a(&spec.mu_s, sizeof spec.mu_s,
                          fnv1a(&spec.mu_r, sizeof spec.mu_r, fnv1a(&spec.seed, sizeof spec.seed)));
     }
-    const SteadyState state = steady_state(r, cycle_observables(r, twin.observe), {}, {}, noise);
+    const SteadyState state = steady_state(r, cycle_observables(r, observe), {}, {}, noise);
     runs.push_back({spec.mu_s, spec.seed, state, spec.mu_r});
   }
   return runs;
@@ -946,9 +950,13 @@ ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
 // experiment's positions are exact), poured or placed (a placed run's distances are the
 // DEM's once settled: on 0.31's scans 7.13 and 15.1 um against a placed run, 7.19 and 15.1
 // against a poured one); NaN errors elsewhere. In metres.
-ContactLocatingError contacts_locating_error(const Twin& twin,
-                                             const std::vector<SteadyStateRun>& runs, double mu_s,
-                                             double mu_r) {
+// The scans' errors read from their contacts against the twin's run nearest (mu_s, mu_r).
+struct ContactsReading {
+  ContactLocatingError positions;
+  DisplacementError displacements;
+};
+ContactsReading contacts_locating_error(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+                                        double mu_s, double mu_r) {
   const KnownGrains known = twin.known_grains();
   if (!twin.experiment().header().voxel_size || !known.radius || runs.empty()) return {};
   const auto distance = [&](const SteadyStateRun& r) {  // in ln mu_s (and ln mu_r, joint)
@@ -958,8 +966,11 @@ ContactLocatingError contacts_locating_error(const Twin& twin,
   const auto nearest = std::min_element(
       runs.begin(), runs.end(), [&](auto& a, auto& b) { return distance(a) < distance(b); });
   const FrictionRunSpec spec{nearest->mu_s, nearest->seed, nearest->mu_r};
-  return locating_error_from_contacts(twin.experiment(), TrajectoryReader(twin.path(spec)),
-                                      2 * *known.radius);
+  const TrajectoryReader reference(twin.path(spec));
+  const double diameter = 2 * *known.radius;
+  return {locating_error_from_contacts(twin.experiment(), reference, diameter),
+          displacement_error_from_contacts(twin.experiment(), reference, diameter,
+                                           twin.observe.window)};
 }
 
 // An observable the scans' own noise moves by more than a share of one packing's scatter
@@ -974,32 +985,37 @@ ContactLocatingError contacts_locating_error(const Twin& twin,
 // twin's stay exact (no contacts to read the error from, --axis-noise 0) the positions are
 // judged by locate's standard errors, which a scan's actual error exceeds 2-3x
 // (docs/BENCHMARKS.md), so by a quarter of a scatter (the effects grow as sigma^2: 1-2
-// scatters at the actual error). The displacements are judged so too: the twin's stay
-// exact, as a scan's errors in consecutive frames are partly shared (an independent error
-// of the contacts' size moves the mean displacement ~1.8x as far as the scans' own errors
-// do, docs/CALIBRATION.md), so no noise given to the twin would model them.
+// scatters at the actual error). The displacements likewise: where the scans' persistent
+// contacts give the per-frame error that moves them (a scan's errors in consecutive frames
+// are partly shared: an independent error of the contacts' size moves them ~1.8x as far,
+// the persistent contacts' reading 0.95-1.15x, docs/CALIBRATION.md) the twin's get it and
+// they are judged as modelled; elsewhere by a quarter of a scatter.
 constexpr double kNoiseShare = 0.25;
 constexpr double kModelledNoise = 0.2;
 struct NoiseLimited {
   std::string name;
   double effect, scatter;
-  bool modelled;        // the twin adds the same noise (its axes' or its positions')
+  bool modelled;        // the twin adds the same noise (its axes', positions' or displacements')
   bool dropped = true;  // false: kept, as the fit needs more observables than the rest
 };
 
-// What the scans' noise does to the fit: the observables it leaves out, and the contacts'
-// error where it was read (then given to the twin's positions).
+// What the scans' noise does to the fit: the observables it leaves out, and the errors
+// their contacts read where they were read (then given to the twin's positions and
+// displacements).
 struct ScanNoise {
   std::vector<NoiseLimited> limited;
   ContactLocatingError contacts;
+  DisplacementError displacements;
 };
 
-bool read_from_contacts(const ContactLocatingError& e) {
+template <class E>
+bool read_from_contacts(const E& e) {
   return std::isfinite(e.across) && std::isfinite(e.along_z);
 }
 
-// The contacts' error along x, y and z, m.
-Eigen::Vector3d position_noise(const ContactLocatingError& e) {
+// An error read from the contacts along x, y and z, m.
+template <class E>
+Eigen::Vector3d position_noise(const E& e) {
   return Eigen::Vector3d(e.across, e.across, e.along_z);
 }
 
@@ -1024,13 +1040,19 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   const Eigen::Vector3d e =
       positions_modelled ? position_noise(noise.contacts) / metres_per_length(twin.experiment())
                          : twin.errors.position;
+  const bool displacements_modelled = read_from_contacts(noise.displacements);
+  const Eigen::Vector3d moved_by = displacements_modelled
+                                       ? position_noise(noise.displacements)
+                                       : Eigen::Vector3d(e * metres_per_length(twin.experiment()));
   SteadyState effect;
   double displacement = std::nan("");
   if (e.allFinite() && !e.isZero()) {
     effect =
         structure_noise_effect(twin.experiment(), twin.observe.window, e, {}, twin.known_grains());
-    const CycleObservables moved = measured_observables(twin.experiment(), twin.observe, 0,
-                                                        e * metres_per_length(twin.experiment()));
+  }
+  if (moved_by.allFinite() && !moved_by.isZero()) {
+    const CycleObservables moved =
+        measured_observables(twin.experiment(), twin.observe, 0, moved_by);
     displacement = window_mean_displacement(moved) - twin.measured_steady_state()["dr"];
   }
   double rotation = std::nan("");
@@ -1045,7 +1067,7 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   for (std::size_t k = 0; k < names.size(); ++k) {
     const bool rotation_k = names[k] == "rot_disp", displacement_k = names[k] == "dr";
     const bool modelled = rotation_k       ? twin.observe.axis_noise > 0
-                          : displacement_k ? false
+                          : displacement_k ? displacements_modelled
                                            : positions_modelled;
     const double d = rotation_k ? rotation : displacement_k ? displacement : effect[names[k]];
     if (std::isfinite(d) &&
@@ -1068,9 +1090,14 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
   runs = twin_steady_states(twin, specs);
   Fit fit = fit_to(runs, only);
   ScanNoise found;
-  found.contacts = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
-  if (read_from_contacts(found.contacts)) {
-    runs = twin_steady_states(twin, specs, position_noise(found.contacts));
+  const ContactsReading read = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
+  found.contacts = read.positions;
+  found.displacements = read.displacements;
+  const auto given = [](const auto& e) {
+    return read_from_contacts(e) ? position_noise(e) : Eigen::Vector3d::Zero().eval();
+  };
+  if (read_from_contacts(found.contacts) || read_from_contacts(found.displacements)) {
+    runs = twin_steady_states(twin, specs, given(found.contacts), given(found.displacements));
     fit = fit_to(runs, only);
   }
   if (only.empty()) found.limited = noise_limited(twin, fit.names, fit.scatter, found);
@@ -1110,23 +1137,40 @@ JointObservableFit joint_steady_state_fit(const Twin& twin,
 // The report's lines on the observables left out, and why; their names for summary.json.
 void report_noise_limited(const ScanNoise& noise, std::ostream& report, JsonObject& j) {
   std::vector<std::string> names;
-  const bool contacts = read_from_contacts(noise.contacts);
   for (const NoiseLimited& l : noise.limited) {
-    const bool rotation = l.name == "rot_disp";
+    const bool rotation = l.name == "rot_disp", displacement = l.name == "dr";
+    const bool contacts =
+        displacement ? read_from_contacts(noise.displacements) : read_from_contacts(noise.contacts);
+    const std::string what = rotation ? "axes" : displacement ? "displacements" : "positions";
     report << std::setprecision(3) << "  note: " << l.name
            << (l.dropped ? " left out" : " kept, as the fit needs it,") << ": the scans' own "
            << (rotation ? "axis" : "locating") << " noise"
            << (!rotation && contacts ? " (their contacts' error)" : "") << " moves it by "
            << l.effect << " (one packing's scatter " << l.scatter << ")"
-           << (!l.modelled ? (rotation         ? " and the twin's axes are exact"
-                              : l.name == "dr" ? " and the twin's displacements are exact"
-                                               : " and the twin's positions are exact")
-               : rotation  ? ", more than the twin's tilted axes model"
-                           : ", more than the twin's moved positions model")
+           << (l.modelled ? ", more than the twin's " +
+                                std::string(rotation ? "tilted " : "moved ") + what + " model"
+                          : " and the twin's " + what + " are exact")
            << (l.dropped ? " (--only keeps it)\n" : "\n");
     if (l.dropped) names.push_back(l.name);
   }
   j["left_out_for_scan_noise"] = names;
+}
+
+// The per-frame error that moves the scans' displacements, read from their persistent
+// contacts.
+void report_displacement_error(const DisplacementError& e, std::ostream& report, JsonObject& j) {
+  if (!read_from_contacts(e)) return;
+  const double um = 1e6;
+  report << std::setprecision(3) << "  the scans' displacements err as by " << e.across * um
+         << " um across the slices and " << e.along_z * um
+         << " um along z in each frame, from the change of their persistent contacts ("
+         << e.contacts << "); the twin's displacements were given this error\n";
+  JsonObject c;
+  c["across_um"] = e.across * um;
+  c["along_z_um"] = e.along_z * um;
+  c["contacts"] = e.contacts;
+  c["given_to_twin"] = true;
+  j["displacement_error_from_contacts"] = c;
 }
 
 // The scans' locating error read from their contacts, said beside locate's standard errors.
@@ -1278,6 +1322,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   std::ostringstream left_out;
   report_noise_limited(noise, left_out, j);
   report_contact_error(twin, noise.contacts, left_out, j);
+  report_displacement_error(noise.displacements, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -1353,6 +1398,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   std::ostringstream left_out;
   report_noise_limited(noise, left_out, j);
   report_contact_error(twin, noise.contacts, left_out, j);
+  report_displacement_error(noise.displacements, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]

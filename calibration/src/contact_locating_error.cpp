@@ -10,6 +10,7 @@
 #include "granmem/calibration/cycle_observables.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/point_index.hpp"
+#include "granmem/core/statistics.hpp"
 
 namespace granmem {
 namespace {
@@ -191,7 +192,82 @@ NeighbourGaps gaps_of_every_frame(const TrajectoryReader& run, double diameter, 
   return gaps;
 }
 
+// The change of each persistent contact's length over one cycle, by its direction.
+struct ContactChanges {
+  std::vector<double> horizontal, vertical;
+};
+
+void add_contact_changes(const Vectors3& before, const Vectors3& after, double diameter,
+                         ContactChanges& out) {
+  std::vector<Eigen::Index> seen;  // grains located in both frames
+  for (Eigen::Index i = 0; i < before.rows(); ++i) {
+    if (before.row(i).allFinite() && after.row(i).allFinite()) seen.push_back(i);
+  }
+  Vectors3 start(Eigen::Index(seen.size()), 3);
+  for (std::size_t k = 0; k < seen.size(); ++k)
+    start.row(Eigen::Index(k)) = before.row(seen[k]);
+  const PointIndex index(start);
+  PointIndex::Hits hits;
+  const double touching = 1.01 * diameter;
+  for (std::size_t k = 0; k < seen.size(); ++k) {
+    index.within(start.row(Eigen::Index(k)).transpose(), touching, hits);
+    for (const auto& [j, squared] : hits) {
+      if (j <= k) continue;
+      const double r0 = std::sqrt(squared);
+      const double r1 = (after.row(seen[j]) - after.row(seen[k])).norm();
+      if (r1 >= touching) continue;
+      const double cos_z = std::abs(start(Eigen::Index(j), 2) - start(Eigen::Index(k), 2)) / r0;
+      if (cos_z < 0.3) out.horizontal.push_back(r1 - r0);
+      if (cos_z > 0.8) out.vertical.push_back(r1 - r0);
+    }
+  }
+}
+
+// Every cycle of `window`'s contact changes, the positions in m.
+ContactChanges contact_changes(const TrajectoryReader& run, double diameter,
+                               std::pair<std::int64_t, std::int64_t> window) {
+  const double metres = metres_per_length(run);
+  const std::vector<std::int64_t>& steps = run.steps();
+  ContactChanges changes;
+  for (std::size_t t = 1; t < steps.size(); ++t) {
+    if (steps[t] != steps[t - 1] + 1 || steps[t] < window.first || steps[t] > window.second)
+      continue;
+    add_contact_changes(run.read_frame(t - 1).position * metres,
+                        run.read_frame(t).position * metres, diameter, changes);
+  }
+  return changes;
+}
+
+// 1.4826 x the median absolute deviation: a normal core's standard deviation.
+double robust_spread(const std::vector<double>& x) {
+  const double centre = median(x);
+  std::vector<double> deviation;
+  for (double v : x)
+    deviation.push_back(std::abs(v - centre));
+  return 1.4826 * median(deviation);
+}
+
+// Half the scans' spread less the reference's, in quadrature; NaN from under 100 contacts.
+double per_frame_error(const std::vector<double>& scanned, const std::vector<double>& reference) {
+  if (scanned.size() < 100 || reference.size() < 100) return ContactLocatingError::kNaN;
+  const double s = robust_spread(scanned), r = robust_spread(reference);
+  return 0.5 * std::sqrt(std::max(0.0, s * s - r * r));
+}
+
 }  // namespace
+
+DisplacementError displacement_error_from_contacts(const TrajectoryReader& scans,
+                                                   const TrajectoryReader& reference,
+                                                   double diameter,
+                                                   std::pair<std::int64_t, std::int64_t> window) {
+  const ContactChanges scanned = contact_changes(scans, diameter, window);
+  const ContactChanges exact = contact_changes(reference, diameter, window);
+  DisplacementError e;
+  e.across = per_frame_error(scanned.horizontal, exact.horizontal);
+  e.along_z = per_frame_error(scanned.vertical, exact.vertical);
+  e.contacts = scanned.horizontal.size() + scanned.vertical.size();
+  return e;
+}
 
 void ContactErrorOptions::validate(double diameter) const {
   if (!(diameter > 0) || !std::isfinite(diameter))

@@ -155,6 +155,55 @@ TEST_F(ContactLocatingErrorStores, ReadsTheScansFramesInTheirUnit) {
   EXPECT_NEAR(from_stores.along_z, 20e-6, 2.5e-6);
 }
 
+// One packing at rest scanned in frames 0-3, each frame's centres moved by `shared` (the
+// same in every frame, grain by grain) plus an error of its own, (across, across, along_z)
+// RMS; and the packing itself, exact, as the reference; in m.
+void write_rest_scans(const std::filesystem::path& scans, const std::filesystem::path& exact,
+                      double shared, double across, double along_z) {
+  const Vectors3 packing = poured(3);
+  const Vectors3 fixed = scanned(packing, shared, shared, 1, 40);
+  Trajectories scan, rest;
+  for (Trajectories* run : {&scan, &rest}) {
+    run->header.length_unit = "m";
+    for (Eigen::Index i = 0; i < packing.rows(); ++i) {
+      run->header.id.push_back(i + 1);
+      run->header.radius.push_back(kDiameter / 2);
+    }
+    for (int t = 0; t < 4; ++t) {
+      Frame f = Frame::unknown(run->header);
+      f.step = t;
+      f.position = run == &rest ? packing : scanned(fixed, across, along_z, 1, 50 + t);
+      run->frames.push_back(f);
+    }
+  }
+  write_trajectories(scans, scan);
+  write_trajectories(exact, rest);
+}
+
+// A packing at rest: a persistent contact's change is the two centres' errors' change along
+// it, 2 s spread for independent errors of s per frame, so the reading is each frame's own
+// error, across the slices on horizontal contacts and along z on vertical ones; an error a
+// grain keeps from frame to frame moves no displacement and is not read.
+TEST_F(ContactLocatingErrorStores, DisplacementsErrByEachFramesOwnErrorAlongTheContacts) {
+  write_rest_scans(path("own.h5"), path("exact.h5"), 0, 5e-6, 10e-6);
+  const TrajectoryReader exact(path("exact.h5"));
+  const DisplacementError own =
+      displacement_error_from_contacts(TrajectoryReader(path("own.h5")), exact, kDiameter, {1, 3});
+  EXPECT_GT(own.contacts, 500u);
+  EXPECT_NEAR(own.across, 5e-6, 0.6e-6);
+  EXPECT_NEAR(own.along_z, 10e-6, 1.2e-6);
+  write_rest_scans(path("kept.h5"), path("exact.h5"), 8e-6, 3e-6, 6e-6);
+  const DisplacementError kept =
+      displacement_error_from_contacts(TrajectoryReader(path("kept.h5")), exact, kDiameter, {1, 3});
+  EXPECT_NEAR(kept.across, 3e-6, 0.4e-6);
+  EXPECT_NEAR(kept.along_z, 6e-6, 0.8e-6);
+  // Read against themselves, the scans' changes are all true ones: no error.
+  const DisplacementError self = displacement_error_from_contacts(
+      TrajectoryReader(path("own.h5")), TrajectoryReader(path("own.h5")), kDiameter, {1, 3});
+  EXPECT_EQ(self.across, 0);
+  EXPECT_EQ(self.along_z, 0);
+}
+
 TEST_F(ContactLocatingErrorTest, RefusesARangeOutsideItsReachAndNoDiameter) {
   ContactErrorOptions wide;
   wide.below = 0.4;

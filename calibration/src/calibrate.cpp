@@ -955,8 +955,8 @@ struct ContactsReading {
   ContactLocatingError positions;
   DisplacementError displacements;
 };
-ContactsReading contacts_locating_error(const Twin& twin, const std::vector<SteadyStateRun>& runs,
-                                        double mu_s, double mu_r) {
+ContactsReading errors_from_contacts(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+                                     double mu_s, double mu_r) {
   const KnownGrains known = twin.known_grains();
   if (!twin.experiment().header().voxel_size || !known.radius || runs.empty()) return {};
   const auto distance = [&](const SteadyStateRun& r) {  // in ln mu_s (and ln mu_r, joint)
@@ -1026,11 +1026,13 @@ double fitted_mu_r(const JointObservableFit& f) {
   return f.mu_r;
 }
 
-// The window mean of the per-cycle mean end-of-cycle displacement (the steady state's "dr").
-double window_mean_displacement(const CycleObservables& o) {
+// The window means of the per-cycle mean displacements (the steady state's "dr" and
+// "rot_disp"), without the structure steady_state() measures from every frame.
+SteadyState window_mean_motion(const CycleObservables& o) {
   ObservableSeries s;
   s.entries.push_back({"dr", o.cycle, o.mean_dr, false});
-  return window_means(s, o.window)["dr"];
+  s.entries.push_back({"rot_disp", o.cycle, o.mean_rot_disp, false});
+  return window_means(s, o.window);
 }
 
 std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std::string>& names,
@@ -1053,15 +1055,13 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
   if (moved_by.allFinite() && !moved_by.isZero()) {
     const CycleObservables moved =
         measured_observables(twin.experiment(), twin.observe, 0, moved_by);
-    displacement = window_mean_displacement(moved) - twin.measured_steady_state()["dr"];
+    displacement = window_mean_motion(moved)["dr"] - twin.measured_steady_state()["dr"];
   }
   double rotation = std::nan("");
   if (twin.errors.axis > 0 && twin.observe.rotations) {
     const CycleObservables tilted =
         measured_observables(twin.experiment(), twin.observe, twin.errors.axis);
-    const KnownGrains known = twin.known_grains();
-    rotation = steady_state(twin.experiment(), tilted, {}, known)["rot_disp"] -
-               twin.measured_steady_state()["rot_disp"];
+    rotation = window_mean_motion(tilted)["rot_disp"] - twin.measured_steady_state()["rot_disp"];
   }
   std::vector<NoiseLimited> limited;
   for (std::size_t k = 0; k < names.size(); ++k) {
@@ -1090,7 +1090,7 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
   runs = twin_steady_states(twin, specs);
   Fit fit = fit_to(runs, only);
   ScanNoise found;
-  const ContactsReading read = contacts_locating_error(twin, runs, fit.mu_s, fitted_mu_r(fit));
+  const ContactsReading read = errors_from_contacts(twin, runs, fit.mu_s, fitted_mu_r(fit));
   found.contacts = read.positions;
   found.displacements = read.displacements;
   const auto given = [](const auto& e) {

@@ -1,13 +1,17 @@
 // Diagnostic: a placed twin's replicas right after settling (docs/CALIBRATION.md, "Twins of
-// tracked scans"): the grains of a run's first frame (a simulation's, or tracked scans')
+// tracked scans", "The placed packing tapped by its own settle"): the grains of a run's frame
+// (a simulation's, or tracked scans'; the first, or that of --cycle)
 // placed as calibrate --deposit experiment places them, each replica moved by the jitter
 // of its seed and settled at the run's friction; one line per replica with its packing
 // fraction, lid height and contacts per grain, then their spread.
 //
 //   placed_replicas RUN.h5 --grains 2500 --box 5cm --mu-s 0.31 [--replicas 4]
-//                          [--jitter 5e-7 (m; default 1e-4 grain diameters)]
+//                          [--jitter 5e-7 (m; default 1e-4 grain diameters)] [--cycle 20]
+//                          [--settling-damping 1000 (1/s; default the placed packing's)]
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -25,19 +29,33 @@ int main(int argc, char** argv) {
   }
   RunSettings v = default_simulate_settings();
   int replicas = 4;
+  std::int64_t cycle = -1;
+  double damping = std::nan("");
   double jitter = std::nan("");
-  const bool ok =
-      bench::parse_options(argc - 1, argv + 1, "placed_replicas",
-                           {{"--grains", [&](const std::string& s) { v["grains"] = s; }},
-                            {"--box", [&](const std::string& s) { v["box"] = s; }},
-                            {"--mu-s", [&](const std::string& s) { v["mu-s"] = s; }},
-                            {"--replicas", [&](const std::string& s) { replicas = std::stoi(s); }},
-                            {"--jitter", [&](const std::string& s) { jitter = std::stod(s); }}});
+  const bool ok = bench::parse_options(
+      argc - 1, argv + 1, "placed_replicas",
+      {{"--grains", [&](const std::string& s) { v["grains"] = s; }},
+       {"--box", [&](const std::string& s) { v["box"] = s; }},
+       {"--mu-s", [&](const std::string& s) { v["mu-s"] = s; }},
+       {"--replicas", [&](const std::string& s) { replicas = std::stoi(s); }},
+       {"--jitter", [&](const std::string& s) { jitter = std::stod(s); }},
+       {"--cycle", [&](const std::string& s) { cycle = std::stoll(s); }},
+       {"--settling-damping", [&](const std::string& s) { damping = std::stod(s); }}});
   if (!ok || replicas < 2) return 2;
   const PhysicsOptions physics = physics_from(v);
   DepositOptions deposit = deposit_from(v);
+  if (std::isfinite(damping)) deposit.placed_settling_damping = damping;
   if (!std::isfinite(jitter)) jitter = 1e-4 * 2 * deposit.radius;
-  const Grains placed = grains_of_frame(TrajectoryReader(argv[1]), 0, deposit, physics);
+  const TrajectoryReader run(argv[1]);
+  const auto& steps = run.steps();
+  const std::size_t frame =
+      cycle < 0 ? 0 : std::size_t(std::find(steps.begin(), steps.end(), cycle) - steps.begin());
+  if (frame >= steps.size()) {
+    std::fprintf(stderr, "placed_replicas: %s has no frame of cycle %lld\n", argv[1],
+                 static_cast<long long>(cycle));
+    return 2;
+  }
+  const Grains placed = grains_of_frame(run, frame, deposit, physics);
   double sum = 0, sum2 = 0, lid = 0, lid2 = 0;
   for (int seed = 1; seed <= replicas; ++seed) {
     DepositSummary s;

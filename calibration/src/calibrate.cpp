@@ -515,7 +515,9 @@ class Twin {
       case TwinPreparation::experiment:
         return "placed where the experiment's frame of cycle " + std::to_string(placed_cycle_) +
                " has its " + std::to_string(placed_->size()) + " grains, moved by " +
-               number_text(placed_jitter_ * 1e3) + " mm RMS a coordinate, settled at each friction";
+               number_text(placed_jitter_ * 1e3) +
+               " mm RMS a coordinate, settled at each friction " + "under a drag of " +
+               number_text(deposit_.placed_settling_damping) + "/s";
       default:
         return "deposited at each friction";
     }
@@ -686,6 +688,8 @@ class Twin {
     if (placed_) {  // runs placed from another experiment's packing are other runs
       series.protocol.parameters["calibrate/placed_from"] = placed_identity();
       series.protocol.parameters["calibrate/placed_jitter"] = number_text(placed_jitter_) + " m";
+      series.protocol.parameters["calibrate/placed_settling_damping"] =
+          number_text(deposit_.placed_settling_damping) + " 1/s";
       series.protocol.parameters["calibrate/placed_cycle"] = std::to_string(placed_cycle_);
     }
     series.protocol.validate(deposit_.box_side, physics_.dt);

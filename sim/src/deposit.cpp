@@ -132,6 +132,8 @@ Simulation settled_packing(Grains grains, const DepositOptions& o, const Physics
   Simulation sim(std::move(grains), box, physics);
   sim.set_threads(o.threads);
   double settling = placement == GrainPlacement::poured ? settle(sim, o, "falling", progress) : 0.0;
+  DepositOptions settled = o;
+  if (placement == GrainPlacement::at_rest) settled.settling_damping = o.placed_settling_damping;
 
   if (o.lid_mass > 0) {
     const double top = packing_height(sim);
@@ -141,9 +143,9 @@ Simulation settled_packing(Grains grains, const DepositOptions& o, const Physics
     lid.z = top;  // resting on the highest grain
     lid.v = 0;
     sim.refresh_forces();
-    settling += settle(sim, o, "under the lid", progress);
+    settling += settle(sim, settled, "under the lid", progress);
   } else if (placement == GrainPlacement::at_rest) {
-    settling += settle(sim, o, "in place", progress);
+    settling += settle(sim, settled, "in place", progress);
   }
   sim = in_spatial_order(sim);
   if (summary) {

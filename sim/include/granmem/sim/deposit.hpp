@@ -25,6 +25,14 @@ struct DepositOptions {
   // Settled when the kinetic energy per grain is below this, J.
   double settled_energy = 1e-13;
   double settling_damping = 5.0;  // background drag rate while settling, 1/s
+  // The drag rate while a packing placed where a frame has it settles (GrainPlacement::at_rest),
+  // 1/s. A scan's locating errors (~0.002 d) exceed its contacts' overlaps (~5e-4 d under the
+  // paper's lid): released under the pouring drag, the overlaps kick the grains as a tap
+  // would, and the placed packing settles a cycle's compaction denser than its frame (133 um
+  // lower on 2,500 grains); at this drag it keeps its frame's height within ~10 um, from
+  // exact frames and scans alike (docs/CALIBRATION.md, "The placed packing tapped by its own
+  // settle").
+  double placed_settling_damping = 1000;
   double max_settling_time = 10;  // s, per stage; not settled by then is an error
   int threads = 0;  // of its simulation: Simulation::set_threads (0: by the number of grains)
 
@@ -57,8 +65,8 @@ enum class GrainPlacement { poured, at_rest };
 // deposit()'s stages from `grains` already in the box: poured grains settled under gravity,
 // then the lid placed on the highest grain and settled again; grains at rest in a packing
 // get the lid at once (settled without it, a packing placed with no contact forces would
-// first spread and sag under its own weight, then be pressed again). The grains are
-// relabelled in spatial order.
+// first spread and sag under its own weight, then be pressed again) and settle under
+// options.placed_settling_damping. The grains are relabelled in spatial order.
 Simulation settled_packing(Grains grains, const DepositOptions& options,
                            const PhysicsOptions& physics, GrainPlacement placement,
                            DepositSummary* summary = nullptr, const DepositProgress& progress = {});

@@ -14,7 +14,8 @@ namespace granmem {
 // experiment's own packing, so that the packing-to-packing scatter of a pour (its density,
 // its structure) is the experiment's and not the twin's. Positions only: a scan has no
 // contact forces or velocities, so the placed grains start at rest with no contact history
-// and are settled (settled_packing) at the twin's friction before the drive.
+// and are settled (settled_packing, under DepositOptions::placed_settling_damping, so that a
+// scan's locating errors do not tap them denser) at the twin's friction before the drive.
 //
 // Each grain at its position in the frame, in the container's frame (the run's box corner
 // at the origin) and in metres; a grain the frame misses at its position in the first later

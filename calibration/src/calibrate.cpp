@@ -436,6 +436,7 @@ class Twin {
   const CalibrateOptions& options() const { return o_; }
   // The cycle the twin's runs start after (a placed twin's; 0 for a prepared packing).
   std::int64_t first_cycle() const { return placed_cycle_; }
+  bool placed() const { return placed_.has_value(); }
   const TrajectoryReader& experiment() const { return experiment_; }
   // The seeds after the design's: packings none of its runs pour.
   std::uint64_t next_seed(int k) const { return seeds_.back() + 1 + std::uint64_t(k); }
@@ -804,6 +805,18 @@ void add_protocol(JsonObject& j, const Twin& twin) {
   j["settings"] = twin.settings();
 }
 
+// The scans' locating error (m, along x, y and z) given to a run's positions, in the run's
+// unit, each run its own draws; none where it is zero.
+PositionNoise run_position_noise(const FrictionRunSpec& spec, const Eigen::Vector3d& error,
+                                 const TrajectoryReader& r) {
+  PositionNoise noise;
+  if (error.isZero()) return noise;
+  noise.sigma = error / metres_per_length(r);
+  noise.seed = fnv1a(&spec.mu_s, sizeof spec.mu_s,
+                     fnv1a(&spec.mu_r, sizeof spec.mu_r, fnv1a(&spec.seed, sizeof spec.seed)));
+  return noise;
+}
+
 // The twin's runs' steady states. `position_noise` (m, along x, y and z): the scans'
 // locating error, given to every run's positions before their structure is measured, each
 // run its own draws; `displacement_noise` (m): the per-frame error that moves the scans'
@@ -817,13 +830,8 @@ std::vector<SteadyStateRun> twin_steady_states(
   std::vector<SteadyStateRun> runs;
   for (const FrictionRunSpec& spec : specs) {
     const TrajectoryReader r(twin.path(spec));
-    PositionNoise noise;
-    if (!position_noise.isZero()) {
-      noise.sigma = position_noise / metres_per_length(r);
-      noise.seed = fnv1a(&spec.mu_s, sizeof spec.mu_s,
-                         fnv1a(&spec.mu_r, sizeof spec.mu_r, fnv1a(&spec.seed, sizeof spec.seed)));
-    }
-    const SteadyState state = steady_state(r, cycle_observables(r, observe), {}, {}, noise);
+    const SteadyState state = steady_state(r, cycle_observables(r, observe), {}, {},
+                                           run_position_noise(spec, position_noise, r));
     runs.push_back({spec.mu_s, spec.seed, state, spec.mu_r});
   }
   return runs;
@@ -1212,6 +1220,38 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
   j["locating_error_from_contacts"] = c;
 }
 
+// A placed twin's packing read back at the frame it was placed from: the structure of the
+// run nearest the fit there (its positions given the scans' error where their contacts read
+// one) minus the experiment's own. A settle that taps the placed packing denser than its
+// frame leans the fit to higher friction (docs/CALIBRATION.md, "The placed packing tapped by
+// its own settle").
+void report_placed_frame(const Twin& twin, const std::vector<FrictionRunSpec>& specs, double mu_s,
+                         const ContactLocatingError& contacts, std::ostream& report,
+                         JsonObject& j) {
+  if (!twin.placed()) return;
+  const FrictionRunSpec nearest =
+      compared_run(twin, specs, {mu_s, twin.seed()}, [](const FrictionRunSpec&) { return true; });
+  const TrajectoryReader run(twin.path(nearest));
+  const Eigen::Vector3d error =
+      read_from_contacts(contacts) ? position_noise(contacts) : Eigen::Vector3d::Zero();
+  const std::int64_t cycle = twin.first_cycle();
+  const SteadyState placed =
+      frame_structure(run, cycle, {}, {}, run_position_noise(nearest, error, run));
+  const SteadyState own = frame_structure(twin.experiment(), cycle, {}, twin.known_grains());
+  JsonObject differences;
+  report << std::setprecision(3) << "  the placed packing read back at its frame of cycle " << cycle
+         << " (mu_s " << nearest.mu_s << ", seed " << nearest.seed
+         << "), less the experiment's:" << std::setprecision(2);
+  for (const std::string& name : placed.names) {
+    const double difference = placed[name] - own[name];
+    if (!std::isfinite(difference)) continue;
+    report << " " << name << " " << std::showpos << difference << std::noshowpos;
+    differences[name] = difference;
+  }
+  report << "\n";
+  j["placed_frame_less_experiment"] = differences;
+}
+
 // Strictly inside the range of `simulated`.
 bool interior(double mu, const std::vector<double>& simulated) {
   const auto [lo, hi] = std::minmax_element(simulated.begin(), simulated.end());
@@ -1327,6 +1367,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   report_noise_limited(noise, left_out, j);
   report_contact_error(twin, noise.contacts, left_out, j);
   report_displacement_error(noise.displacements, left_out, j);
+  report_placed_frame(twin, specs, fit.mu_s, noise.contacts, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]

@@ -329,6 +329,20 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
   return effect;
 }
 
+SteadyState frame_structure(const TrajectoryReader& run, std::int64_t cycle,
+                            const StructureOptions& structure, const KnownGrains& known,
+                            const PositionNoise& noise) {
+  const auto& steps = run.steps();
+  if (std::find(steps.begin(), steps.end(), cycle) == steps.end()) {
+    throw Error(run.file_name() + ": has no frame of cycle " + std::to_string(cycle));
+  }
+  ObservableSeries s;
+  add_structure_series(s, run, structure, known, {cycle, cycle}, noise);
+  SteadyState at = window_means(s, {cycle, cycle});
+  at.drift.assign(at.values.size(), 0.0);
+  return at;
+}
+
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,
                          const StructureOptions& structure, const KnownGrains& known,
                          const PositionNoise& noise) {

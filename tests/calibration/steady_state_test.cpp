@@ -8,6 +8,7 @@
 #include "checks.hpp"
 #include "granmem/calibration/comparison.hpp"
 #include "granmem/calibration/cycle_observables.hpp"
+#include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "temp_dir.hpp"
@@ -238,6 +239,30 @@ TEST_F(SteadyStateTest, PositionsGivenAScansErrorReadTheStructureSuchScansRead) 
 
 // compare's options (the window and wall distance it pools these observables with),
 // checked before either run is read: the defaults with a folder pass.
+// A placed twin's packing read back at the frame it was placed from: that frame's structure
+// alone, its positions given a scan's error as the window's are.
+TEST_F(SteadyStateTest, AFramesStructureIsThatFramesAlone) {
+  Trajectories t = cubic_run();
+  for (Eigen::Index k = 0; k < t.frames[2].position.rows(); ++k)
+    t.frames[2].position(k, 2) *= 1.1;  // cycle 2: the layers 0.1 d apart
+  write_trajectories(path("stretched.h5"), t);
+  const TrajectoryReader run(path("stretched.h5"));
+  const SteadyState touching = frame_structure(run, 1);
+  EXPECT_NEAR(touching["bulk_packing_fraction"], M_PI / 6, 1e-12);
+  EXPECT_DOUBLE_EQ(touching["coordination"], 6);
+  EXPECT_NEAR(touching["height_packing_fraction"], M_PI / 6, 1e-12);
+  const SteadyState apart = frame_structure(run, 2);
+  EXPECT_DOUBLE_EQ(apart["coordination"], 4);  // the layers no longer touch
+  EXPECT_LT(apart["height_packing_fraction"], M_PI / 6 / 1.05);
+  EXPECT_THROW(frame_structure(run, 7), Error);
+  // Given a scan's error: the frame's values moved as the noise check moves them.
+  const PositionNoise noise{Eigen::Vector3d(0.01, 0.01, 0.02), 5};
+  const SteadyState noisy = frame_structure(run, 1, {}, {}, noise);
+  const SteadyState moved = structure_noise_effect(run, {1, 1}, noise.sigma, {}, {}, noise.seed);
+  for (const std::string& name : moved.names)
+    EXPECT_NEAR(noisy[name], touching[name] + moved[name], 1e-12) << name;
+}
+
 TEST(CompareOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {
   CompareOptions o;
   EXPECT_EQ(testing::error_message([&] { o.validate(); }), "compare: no output folder (--out)");

@@ -153,6 +153,13 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
                                    const Eigen::Vector3d& sigma,
                                    const StructureOptions& structure = {},
                                    const KnownGrains& known = {}, std::uint64_t seed = 1);
+// The observables from positions (bulk and height packing fractions, coordination) of the
+// run's frame of `cycle`, its positions moved by `noise`: a placed twin's packing read back
+// against the experiment's frame it was placed from. Throws Error if the run has no frame of
+// that cycle.
+SteadyState frame_structure(const TrajectoryReader& run, std::int64_t cycle,
+                            const StructureOptions& structure = {}, const KnownGrains& known = {},
+                            const PositionNoise& noise = {});
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at
 // full compression (N)"); the name itself for one it does not know.
 std::string steady_state_label(const std::string& name);

@@ -7,14 +7,13 @@ import json
 import sys
 
 print("label,true_mu_s,mu_s,ci95_low,ci95_high,width,error,interval_holds,bar_met,chi2,dof,"
-      "simulations,settling_damping")
+      "simulations")
 for arg in sys.argv[1:]:
     label, folder = arg.split("=", 1)
     s = json.load(open(folder + "/summary.json"))
     mu, (lo, hi), true = s["mu_s"], s["mu_s_ci95"], s.get("mu_s_true")
     holds = true is not None and lo <= true <= hi
     bar = holds and abs(mu - true) <= 0.02 and hi - lo <= 0.08
-    damping = s.get("settings", {}).get("settling-damping", "")
     print(f"{label},{true},{mu:.4g},{lo:.4g},{hi:.4g},{hi - lo:.3g},{mu - true:+.4f},"
           f"{'yes' if holds else 'no'},{'yes' if bar else 'no'},{s['chi2']:.3g},{s['dof']},"
-          f"{s['n_simulations']},{damping}")
+          f"{s['n_simulations']}")

@@ -35,7 +35,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                                observables = "steady-state", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false;
-    int threads = 0, degree = 2, replicas = 0, refine = -1;
+    int threads = 0, degree = 0, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto", placed_cycle = "auto";
     std::string true_mu_s, true_mu_r;
   };
@@ -76,7 +76,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
       ->capture_default_str();
   add_drift_flags(cmd, args->subtract_drift);
   cmd->add_option("--degree", args->degree,
-                  "degree of the polynomial in log mu_s through the runs' summaries")
+                  "degree of the polynomial in log mu_s through the runs' summaries; 0: 3 "
+                  "for mu_s alone on a twin placed from a simulation's exact frame, else 2")
       ->capture_default_str();
   cmd->add_option("--replicas", args->replicas,
                   "packings per friction (seeds seed, seed+1, ...): their scatter is the "

@@ -322,7 +322,7 @@ FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const Run
                                             const ScanErrors& errors, double diameter,
                                             std::string* noise_model) {
   FrictionFitOptions fit;
-  fit.degree = o.degree;
+  fit.degree = o.degree > 0 ? o.degree : 2;
   fit.per_cycle = o.per_cycle;
   const bool stored = errors.position.allFinite();
   if (o.noise == "scans" || (o.noise == "auto" && stored && h.voxel_size)) {
@@ -437,6 +437,12 @@ class Twin {
   // The cycle the twin's runs start after (a placed twin's; 0 for a prepared packing).
   std::int64_t first_cycle() const { return placed_cycle_; }
   bool placed() const { return placed_.has_value(); }
+  // The trend's degree (CalibrateOptions::degree; 0: by the twin).
+  int trend_degree() const {
+    if (o_.degree > 0) return o_.degree;
+    const bool exact = placed_ && exact_packing_at(experiment_, placed_cycle_);
+    return exact && !o_.joint() && o_.mu_s.size() >= 4 ? 3 : 2;
+  }
   const TrajectoryReader& experiment() const { return experiment_; }
   // The seeds after the design's: packings none of its runs pour.
   std::uint64_t next_seed(int k) const { return seeds_.back() + 1 + std::uint64_t(k); }
@@ -951,9 +957,9 @@ void add_comparison(CalibrateSummary& s, std::ostream& report, const Comparison&
 }
 
 // The twin's runs fitted to the experiment's steady state: mu_s alone, or with mu_r.
-ObservableFitOptions observable_fit_options(const CalibrateOptions& o) {
+ObservableFitOptions observable_fit_options(const Twin& twin) {
   ObservableFitOptions fo;
-  fo.degree = o.degree;
+  fo.degree = twin.trend_degree();
   return fo;
 }
 
@@ -1130,7 +1136,7 @@ ObservableFit steady_state_fit(const Twin& twin, const std::vector<FrictionRunSp
                                std::vector<SteadyStateRun>& runs, ScanNoise* noise = nullptr) {
   auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
     return fit_friction_to_steady_state(twin.measured_steady_state(), r,
-                                        observable_fit_options(twin.options()), names);
+                                        observable_fit_options(twin), names);
   };
   return fit_as_scanned<ObservableFit>(twin, specs, fit_to, 1, runs, noise);
 }
@@ -1141,7 +1147,7 @@ JointObservableFit joint_steady_state_fit(const Twin& twin,
                                           ScanNoise* noise = nullptr) {
   auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
     return fit_frictions_to_steady_state(twin.measured_steady_state(), r,
-                                         observable_fit_options(twin.options()), names);
+                                         observable_fit_options(twin), names);
   };
   return fit_as_scanned<JointObservableFit>(twin, specs, fit_to, 2, runs, noise);
 }
@@ -1665,12 +1671,13 @@ void CalibrateOptions::validate() const {
         "--placed-cycle: not with --window auto (the window is chosen from runs that "
         "start from the experiment's first frame)");
   }
-  if (degree < 1) throw Error("--degree: at least 1");
+  if (degree < 0) throw Error("--degree: at least 1, or 0 (by the twin)");
   // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
-  const std::size_t needed = std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);
+  const int fitted = degree > 0 ? degree : 2;
+  const std::size_t needed = std::size_t(fitted) + (joint() || replicas > 1 ? 1 : 2);
   if (mu_s.size() < needed) {
     throw Error("--mu-s: " + std::to_string(mu_s.size()) + " frictions; the fit needs at least " +
-                std::to_string(needed) + " (degree " + std::to_string(degree) + " + 1" +
+                std::to_string(needed) + " (degree " + std::to_string(fitted) + " + 1" +
                 (replicas > 1 ? "" : ", and one more to measure the runs' scatter") + ")");
   }
   if (noise != "auto" && noise != "fit" && noise != "none" && noise != "scans") {

@@ -325,7 +325,7 @@ def _optional_float(value):
 
 def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="steady-state", only=(), window=None, noise="auto",
-              summaries="pooled", wall_distance=0, subtract_drift=True, degree=2, replicas=None,
+              summaries="pooled", wall_distance=0, subtract_drift=True, degree=0, replicas=None,
               refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto",
               placed_cycle="auto", fit_only=False, true_mu_s=None, true_mu_r=None, parallel=0,
               progress=None, **twin):
@@ -358,7 +358,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     "steady-state" 0.05, 0.14, 0.4 on 3 packings, then 3 more at their fit (12 runs; a twin
     placed from the experiment's packing 0.05, 0.13, 0.35, 0.6 on 2, then 4 more at their fit), for the
     joint fit 0.05, 0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08,
-    0.12, 0.2, 0.3, 0.5 on 2.
+    0.12, 0.2, 0.3, 0.5 on 2. ``degree``: of the trend in ln mu_s through the runs; 0: 3 for
+    mu_s alone on a twin placed from a simulation's exact frame, else 2.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``

@@ -107,7 +107,13 @@ struct CalibrateOptions {
   // has them (scan_errors.hpp), else none.
   std::optional<double> axis_noise;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
-  int degree = 2;              // of the polynomial in ln mu_s through the runs
+  // Of the polynomial in ln mu_s through the runs; 0: 3 where mu_s alone is fitted on a twin
+  // placed from a simulation's exact frame over at least four frictions (over 0.05-0.6 the
+  // observables bend between 0.13 and 0.35, and a quadratic leaves 4-7x the packings' scatter;
+  // docs/CALIBRATION.md, "The placed packing tapped by its own settle"), else 2. Scans keep 2:
+  // what is left of their systematic error is not carried, and the cubic's narrow intervals
+  // missed one of five scanned truths.
+  int degree = 0;
   // Packings per friction (seeds seed, seed + 1, ...); 0: the observables' own design (so a
   // caller's 0 is not refused, it is the default).
   int replicas = 0;

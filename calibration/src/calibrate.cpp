@@ -523,7 +523,7 @@ class Twin {
         return "placed where the experiment's frame of cycle " + std::to_string(placed_cycle_) +
                " has its " + std::to_string(placed_->size()) + " grains, moved by " +
                number_text(placed_jitter_ * 1e3) +
-               " mm RMS a coordinate, settled at each friction " + "under a drag of " +
+               " mm RMS a coordinate, settled at each friction under a drag of " +
                number_text(deposit_.placed_settling_damping) + "/s";
       default:
         return "deposited at each friction";

@@ -142,18 +142,6 @@ TwinPreparation preparation_named(const std::string& name, const std::string& op
   throw Error(option + " '" + name + "': expected each, shared, experiment or auto");
 }
 
-namespace {
-
-// The index of the run's frame of `cycle`, if it has one.
-std::optional<std::size_t> frame_of_cycle(const TrajectoryReader& run, std::int64_t cycle) {
-  const auto& steps = run.steps();
-  const auto at = std::find(steps.begin(), steps.end(), cycle);
-  if (at == steps.end()) return std::nullopt;
-  return std::size_t(at - steps.begin());
-}
-
-}  // namespace
-
 bool exact_packing_at(const TrajectoryReader& run, std::int64_t cycle) {
   const RunHeader& h = run.header();
   if (!h.has_orientation || h.has_position_error) return false;

@@ -220,13 +220,18 @@ std::string steady_state_label(const std::string& name) {
 
 namespace {
 
-// The observables from positions, frame by frame, each position moved by `noise`.
+// Cycles, inclusive, with the public functions' (0, 0) read as every cycle.
+CycleRange every_cycle_if_unset(CycleRange cycles) {
+  if (cycles != CycleRange{0, 0}) return cycles;
+  return {std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()};
+}
+
+// The observables from positions, frame by frame over `cycles` (inclusive), each position
+// moved by `noise`.
 void add_structure_series(ObservableSeries& s, const TrajectoryReader& run,
                           const StructureOptions& structure, const KnownGrains& known,
                           CycleRange cycles, const PositionNoise& noise) {
-  const auto in_range = [&](std::int64_t c) {
-    return cycles.second == 0 || (c >= cycles.first && c <= cycles.second);
-  };
+  const auto in_range = [&](std::int64_t c) { return c >= cycles.first && c <= cycles.second; };
   Random random(noise.seed);
   const Eigen::Vector3d& jitter = noise.sigma;
   ObservableSeries::Entry packing{"bulk_packing_fraction", {}, {}, true},
@@ -269,7 +274,7 @@ ObservableSeries observable_series(const TrajectoryReader& run, const CycleObser
                   [](double v) { return std::isfinite(v); })) {
     s.entries.push_back({"rot_disp", observed.cycle, observed.mean_rot_disp, false});
   }
-  add_structure_series(s, run, structure, known, cycles, noise);
+  add_structure_series(s, run, structure, known, every_cycle_if_unset(cycles), noise);
   // The store's own, under the names the fit knows them by: the wall force at the end of
   // each cycle is the packing's lateral stress with the wall back at its start.
   const std::pair<const char*, const char*> stored[] = {
@@ -319,8 +324,9 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
                                    const Eigen::Vector3d& sigma, const StructureOptions& structure,
                                    const KnownGrains& known, std::uint64_t seed) {
   ObservableSeries plain, jittered;
-  add_structure_series(plain, run, structure, known, window, {});
-  add_structure_series(jittered, run, structure, known, window, {sigma, seed});
+  add_structure_series(plain, run, structure, known, every_cycle_if_unset(window), {});
+  add_structure_series(jittered, run, structure, known, every_cycle_if_unset(window),
+                       {sigma, seed});
   SteadyState effect = window_means(jittered, window);
   const SteadyState as_measured = window_means(plain, window);
   for (std::size_t k = 0; k < effect.values.size(); ++k)
@@ -329,11 +335,17 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
   return effect;
 }
 
+std::optional<std::size_t> frame_of_cycle(const TrajectoryReader& run, std::int64_t cycle) {
+  const auto& steps = run.steps();
+  const auto at = std::find(steps.begin(), steps.end(), cycle);
+  if (at == steps.end()) return std::nullopt;
+  return std::size_t(at - steps.begin());
+}
+
 SteadyState frame_structure(const TrajectoryReader& run, std::int64_t cycle,
                             const StructureOptions& structure, const KnownGrains& known,
                             const PositionNoise& noise) {
-  const auto& steps = run.steps();
-  if (std::find(steps.begin(), steps.end(), cycle) == steps.end()) {
+  if (!frame_of_cycle(run, cycle)) {
     throw Error(run.file_name() + ": has no frame of cycle " + std::to_string(cycle));
   }
   ObservableSeries s;

@@ -237,8 +237,6 @@ TEST_F(SteadyStateTest, PositionsGivenAScansErrorReadTheStructureSuchScansRead) 
             scanned["coordination"]);
 }
 
-// compare's options (the window and wall distance it pools these observables with),
-// checked before either run is read: the defaults with a folder pass.
 // A placed twin's packing read back at the frame it was placed from: that frame's structure
 // alone, its positions given a scan's error as the window's are.
 TEST_F(SteadyStateTest, AFramesStructureIsThatFramesAlone) {
@@ -263,6 +261,8 @@ TEST_F(SteadyStateTest, AFramesStructureIsThatFramesAlone) {
     EXPECT_NEAR(noisy[name], touching[name] + moved[name], 1e-12) << name;
 }
 
+// compare's options (the window and wall distance it pools these observables with),
+// checked before either run is read: the defaults with a folder pass.
 TEST(CompareOptions, ValidateNamesTheBadOptionAndPassesTheDefaults) {
   CompareOptions o;
   EXPECT_EQ(testing::error_message([&] { o.validate(); }), "compare: no output folder (--out)");

@@ -153,6 +153,8 @@ SteadyState structure_noise_effect(const TrajectoryReader& run, CycleRange windo
                                    const Eigen::Vector3d& sigma,
                                    const StructureOptions& structure = {},
                                    const KnownGrains& known = {}, std::uint64_t seed = 1);
+// The index of the run's frame of `cycle`, if it has one.
+std::optional<std::size_t> frame_of_cycle(const TrajectoryReader& run, std::int64_t cycle);
 // The observables from positions (bulk and height packing fractions, coordination) of the
 // run's frame of `cycle`, its positions moved by `noise`: a placed twin's packing read back
 // against the experiment's frame it was placed from. Throws Error if the run has no frame of

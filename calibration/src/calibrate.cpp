@@ -951,6 +951,22 @@ ObservableFitOptions observable_fit_options(const Twin& twin) {
   return fo;
 }
 
+// The twin's runs at the friction (pair) nearest (mu_s, mu_r), in ln mu_s (and ln mu_r,
+// joint), every packing's, in the runs' order.
+std::vector<FrictionRunSpec> runs_nearest(const std::vector<SteadyStateRun>& runs, double mu_s,
+                                          double mu_r) {
+  const auto distance = [&](const SteadyStateRun& r) {
+    return std::abs(std::log(r.mu_s / mu_s)) +
+           (std::isfinite(mu_r) && r.mu_r > 0 ? std::abs(std::log(r.mu_r / mu_r)) : 0.0);
+  };
+  const auto nearest = std::min_element(
+      runs.begin(), runs.end(), [&](auto& a, auto& b) { return distance(a) < distance(b); });
+  std::vector<FrictionRunSpec> at;
+  for (const SteadyStateRun& r : runs)
+    if (r.mu_s == nearest->mu_s && r.mu_r == nearest->mu_r) at.push_back({r.mu_s, r.seed, r.mu_r});
+  return at;
+}
+
 // The scans' locating error read from their contacts (contact_locating_error.hpp) against
 // the twin's run nearest `mu_s`: for scans of grains known to be alike (a simulated
 // experiment's positions are exact), poured or placed (a placed run's distances are the
@@ -965,14 +981,7 @@ ContactsReading errors_from_contacts(const Twin& twin, const std::vector<SteadyS
                                      double mu_s, double mu_r) {
   const KnownGrains known = twin.known_grains();
   if (!twin.experiment().header().voxel_size || !known.radius || runs.empty()) return {};
-  const auto distance = [&](const SteadyStateRun& r) {  // in ln mu_s (and ln mu_r, joint)
-    return std::abs(std::log(r.mu_s / mu_s)) +
-           (std::isfinite(mu_r) && r.mu_r > 0 ? std::abs(std::log(r.mu_r / mu_r)) : 0.0);
-  };
-  const auto nearest = std::min_element(
-      runs.begin(), runs.end(), [&](auto& a, auto& b) { return distance(a) < distance(b); });
-  const FrictionRunSpec spec{nearest->mu_s, nearest->seed, nearest->mu_r};
-  const TrajectoryReader reference(twin.path(spec));
+  const TrajectoryReader reference(twin.path(runs_nearest(runs, mu_s, mu_r).front()));
   const double diameter = 2 * *known.radius;
   return {locating_error_from_contacts(twin.experiment(), reference, diameter),
           displacement_error_from_contacts(twin.experiment(), reference, diameter,
@@ -1005,6 +1014,47 @@ struct NoiseLimited {
   bool dropped = true;  // false: kept, as the fit needs more observables than the rest
 };
 
+// A placed twin's packing read back at the experiment's frame it was placed from: the mean
+// over the runs nearest the fit of their structure there (their positions given the scans'
+// error where their contacts read one) less the experiment's own. What the twin does not
+// reproduce of the experiment's structure before any cycle: the settle's (the lost contact
+// history) and what the scans' error model misses. The fit carries it as the experiment's
+// systematic error: taken as an offset that persists into the window (the experiment's
+// values moved by it) it moved the scanned cases' fits further from their truth, and chi2
+// up 2-7x (docs/CALIBRATION.md).
+struct PlacedReadBack {
+  SteadyState less_experiment;
+  std::vector<FrictionRunSpec> runs;
+};
+PlacedReadBack placed_read_back(const Twin& twin, const std::vector<SteadyStateRun>& runs,
+                                double mu_s, double mu_r, const Eigen::Vector3d& error) {
+  PlacedReadBack p;
+  if (!twin.placed() || runs.empty()) return p;
+  p.runs = runs_nearest(runs, mu_s, mu_r);
+  const std::int64_t cycle = twin.first_cycle();
+  const SteadyState own = frame_structure(twin.experiment(), cycle, {}, twin.known_grains());
+  p.less_experiment.names = own.names;
+  p.less_experiment.values.assign(own.names.size(), 0.0);
+  for (const FrictionRunSpec& spec : p.runs) {
+    const TrajectoryReader run(twin.path(spec));
+    const SteadyState placed =
+        frame_structure(run, cycle, {}, {}, run_position_noise(spec, error, run));
+    for (std::size_t k = 0; k < own.names.size(); ++k)
+      p.less_experiment.values[k] += (placed[own.names[k]] - own.values[k]) / double(p.runs.size());
+  }
+  return p;
+}
+
+// The experiment's steady state with a placed packing's read-back as its systematic errors.
+SteadyState with_systematic(SteadyState experiment, const PlacedReadBack& placed) {
+  experiment.systematic.assign(experiment.names.size(), 0.0);
+  for (std::size_t k = 0; k < experiment.names.size(); ++k) {
+    const double d = placed.less_experiment[experiment.names[k]];
+    if (std::isfinite(d)) experiment.systematic[k] = std::abs(d);
+  }
+  return experiment;
+}
+
 // What the scans' noise does to the fit: the observables it leaves out, and the errors
 // their contacts read where they were read (then given to the twin's positions and
 // displacements).
@@ -1012,6 +1062,7 @@ struct ScanNoise {
   std::vector<NoiseLimited> limited;
   ContactLocatingError contacts;
   DisplacementError displacements;
+  PlacedReadBack placed;
 };
 
 template <class E>
@@ -1086,15 +1137,17 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
 // The twin's runs fitted to the experiment, as a scan would see them: where the scans'
 // contacts give their locating error (read against the run nearest a first fit of the runs'
 // exact positions), the runs' positions are given it before their structure is measured,
-// and the fit is made again; then without the observables the scans' noise still moves,
-// unless they were chosen with --only. `fewest`: the observables the fit needs. `runs`: the
-// runs' steady states as fitted.
+// and the fit is made again; a placed twin's then again with its packing's read-back as the
+// experiment's systematic errors; then without the observables the scans' noise still
+// moves, unless they were chosen with --only. `fewest`: the observables the fit needs.
+// `runs`: the runs' steady states as fitted.
 template <class Fit, class FitTo>
 Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, FitTo fit_to,
                    std::size_t fewest, std::vector<SteadyStateRun>& runs, ScanNoise* noise) {
   const std::vector<std::string>& only = twin.options().only;
+  SteadyState experiment = twin.measured_steady_state();
   runs = twin_steady_states(twin, specs);
-  Fit fit = fit_to(runs, only);
+  Fit fit = fit_to(experiment, runs, only);
   ScanNoise found;
   const ContactsReading read = errors_from_contacts(twin, runs, fit.mu_s, fitted_mu_r(fit));
   found.contacts = read.positions;
@@ -1104,7 +1157,12 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
   };
   if (read_from_contacts(found.contacts) || read_from_contacts(found.displacements)) {
     runs = twin_steady_states(twin, specs, given(found.contacts), given(found.displacements));
-    fit = fit_to(runs, only);
+    fit = fit_to(experiment, runs, only);
+  }
+  found.placed = placed_read_back(twin, runs, fit.mu_s, fitted_mu_r(fit), given(found.contacts));
+  if (!found.placed.runs.empty()) {
+    experiment = with_systematic(experiment, found.placed);
+    fit = fit_to(experiment, runs, only);
   }
   if (only.empty()) found.limited = noise_limited(twin, fit.names, fit.scatter, found);
   std::vector<std::string> kept;
@@ -1117,14 +1175,14 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
   for (NoiseLimited& l : found.limited)
     l.dropped = refit_without;
   if (noise) *noise = found;
-  return refit_without ? fit_to(runs, kept) : fit;
+  return refit_without ? fit_to(experiment, runs, kept) : fit;
 }
 
 ObservableFit steady_state_fit(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                                std::vector<SteadyStateRun>& runs, ScanNoise* noise = nullptr) {
-  auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
-    return fit_friction_to_steady_state(twin.measured_steady_state(), r,
-                                        observable_fit_options(twin), names);
+  auto fit_to = [&](const SteadyState& experiment, const std::vector<SteadyStateRun>& r,
+                    const std::vector<std::string>& names) {
+    return fit_friction_to_steady_state(experiment, r, observable_fit_options(twin), names);
   };
   return fit_as_scanned<ObservableFit>(twin, specs, fit_to, 1, runs, noise);
 }
@@ -1133,9 +1191,9 @@ JointObservableFit joint_steady_state_fit(const Twin& twin,
                                           const std::vector<FrictionRunSpec>& specs,
                                           std::vector<SteadyStateRun>& runs,
                                           ScanNoise* noise = nullptr) {
-  auto fit_to = [&](const std::vector<SteadyStateRun>& r, const std::vector<std::string>& names) {
-    return fit_frictions_to_steady_state(twin.measured_steady_state(), r,
-                                         observable_fit_options(twin), names);
+  auto fit_to = [&](const SteadyState& experiment, const std::vector<SteadyStateRun>& r,
+                    const std::vector<std::string>& names) {
+    return fit_frictions_to_steady_state(experiment, r, observable_fit_options(twin), names);
   };
   return fit_as_scanned<JointObservableFit>(twin, specs, fit_to, 2, runs, noise);
 }
@@ -1219,31 +1277,25 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
 // one) minus the experiment's own. A settle that taps the placed packing denser than its
 // frame leans the fit to higher friction (docs/CALIBRATION.md, "The placed packing tapped by
 // its own settle").
-void report_placed_frame(const Twin& twin, const std::vector<FrictionRunSpec>& specs, double mu_s,
-                         const ContactLocatingError& contacts, std::ostream& report,
+// The placed packing's read-back, which the fit carried as the experiment's systematic errors.
+void report_placed_frame(const Twin& twin, const PlacedReadBack& placed, std::ostream& report,
                          JsonObject& j) {
-  if (!twin.placed()) return;
-  const FrictionRunSpec nearest =
-      compared_run(twin, specs, {mu_s, twin.seed()}, [](const FrictionRunSpec&) { return true; });
-  const TrajectoryReader run(twin.path(nearest));
-  const Eigen::Vector3d error =
-      read_from_contacts(contacts) ? position_noise(contacts) : Eigen::Vector3d::Zero();
-  const std::int64_t cycle = twin.first_cycle();
-  const SteadyState placed =
-      frame_structure(run, cycle, {}, {}, run_position_noise(nearest, error, run));
-  const SteadyState own = frame_structure(twin.experiment(), cycle, {}, twin.known_grains());
+  if (placed.runs.empty()) return;
   JsonObject differences;
-  report << std::setprecision(3) << "  the placed packing read back at its frame of cycle " << cycle
-         << " (mu_s " << nearest.mu_s << ", seed " << nearest.seed
+  report << std::setprecision(3) << "  the placed packing read back at its frame of cycle "
+         << twin.first_cycle() << " (mu_s " << placed.runs.front().mu_s;
+  if (placed.runs.front().mu_r >= 0) report << ", mu_r " << placed.runs.front().mu_r;
+  report << ", " << placed.runs.size() << " packing" << (placed.runs.size() > 1 ? "s" : "")
          << "), less the experiment's:" << std::setprecision(2);
-  for (const std::string& name : placed.names) {
-    const double difference = placed[name] - own[name];
-    if (!std::isfinite(difference)) continue;
-    report << " " << name << " " << std::showpos << difference << std::noshowpos;
-    differences[name] = difference;
+  const SteadyState& d = placed.less_experiment;
+  for (std::size_t k = 0; k < d.names.size(); ++k) {
+    if (!std::isfinite(d.values[k])) continue;
+    report << " " << d.names[k] << " " << std::showpos << d.values[k] << std::noshowpos;
+    differences[d.names[k]] = d.values[k];
   }
-  report << "\n";
+  report << "; carried as the experiment's systematic errors\n";
   j["placed_frame_less_experiment"] = differences;
+  j["placed_frame_runs"] = placed.runs.size();
 }
 
 // Strictly inside the range of `simulated`.
@@ -1337,6 +1389,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   j["mu_s_interval_method"] = fit.method;
   j["log_mu_s_sigma"] = fit.log_mu_s_sigma;
   j["gls_sigma"] = fit.gls_sigma;
+  j["systematic_sigma"] = fit.systematic_sigma;
   j["cross_validated_sigma"] = fit.cross_validated_sigma;
   j["chi2"] = fit.chi2;
   j["dof"] = fit.dof;
@@ -1361,7 +1414,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   report_noise_limited(noise, left_out, j);
   report_contact_error(twin, noise.contacts, left_out, j);
   report_displacement_error(noise.displacements, left_out, j);
-  report_placed_frame(twin, specs, fit.mu_s, noise.contacts, left_out, j);
+  report_placed_frame(twin, noise.placed, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -1369,8 +1422,11 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
   report << "\n" << observables_line(twin, fit.names, &fit.resolution);
   report << "  chi2 " << fit.chi2 << " for " << fit.dof << " dof; +-" << fit.gls_sigma
-         << " in ln mu_s from the fit, cross-validated " << fit.cross_validated_sigma
-         << " in ln mu_s at the fit from " << fit.cross_validations << " runs\n";
+         << " in ln mu_s from the fit";
+  if (fit.systematic_sigma > 0)
+    report << " (" << fit.systematic_sigma << " of it the experiment's systematic errors)";
+  report << ", cross-validated " << fit.cross_validated_sigma << " in ln mu_s at the fit from "
+         << fit.cross_validations << " runs\n";
   report << left_out.str();
   for (const std::string& note : written.notes)
     report << "  note: " << note << "\n";
@@ -1438,6 +1494,8 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   report_noise_limited(noise, left_out, j);
   report_contact_error(twin, noise.contacts, left_out, j);
   report_displacement_error(noise.displacements, left_out, j);
+  report_placed_frame(twin, noise.placed, left_out, j);
+  j["systematic_sigma"] = fit.systematic_sigma;
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]

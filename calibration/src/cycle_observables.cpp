@@ -194,14 +194,26 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
   return f;
 }
 
-double SteadyState::operator[](const std::string& name) const {
+namespace {
+// The entry of `per_name` (one per name, or none) for `name`; `missing` where there is none.
+double named_entry(const std::vector<std::string>& names, const std::vector<double>& per_name,
+                   const std::string& name, double missing) {
   const auto it = std::find(names.begin(), names.end(), name);
-  return it == names.end() ? std::nan("") : values[std::size_t(it - names.begin())];
+  return it == names.end() || per_name.empty() ? missing
+                                               : per_name[std::size_t(it - names.begin())];
+}
+}  // namespace
+
+double SteadyState::operator[](const std::string& name) const {
+  return named_entry(names, values, name, std::nan(""));
 }
 
 double SteadyState::drift_of(const std::string& name) const {
-  const auto it = std::find(names.begin(), names.end(), name);
-  return it == names.end() || drift.empty() ? std::nan("") : drift[std::size_t(it - names.begin())];
+  return named_entry(names, drift, name, std::nan(""));
+}
+
+double SteadyState::systematic_of(const std::string& name) const {
+  return named_entry(names, systematic, name, 0.0);
 }
 
 std::string steady_state_label(const std::string& name) {

@@ -106,6 +106,11 @@ Trend fit_trend(const std::vector<ObservableRun>& runs, int dims, int degree) {
   return t;
 }
 
+// The experiment's observables and each one's systematic variance (zero for a held-out run).
+struct Target {
+  Eigen::VectorXd value, systematic;
+};
+
 struct Misfit {
   const Trend* trend;
   Eigen::VectorXd target;
@@ -120,9 +125,12 @@ struct Misfit {
   }
 };
 
-// C = (1 + leverage) Sigma at x: the experiment's realization and the trend's error.
-Eigen::MatrixXd whitening_at(const Trend& t, const LogFriction& x) {
-  const Eigen::MatrixXd c = (1 + t.leverage(x)) * t.covariance;
+// C = (1 + leverage) Sigma + S at x: the experiment's realization, the trend's error and
+// the experiment's systematic variances S.
+Eigen::MatrixXd whitening_at(const Trend& t, const LogFriction& x,
+                             const Eigen::VectorXd& systematic) {
+  Eigen::MatrixXd c = (1 + t.leverage(x)) * t.covariance;
+  c.diagonal() += systematic;
   return c.llt().matrixL().solve(Eigen::MatrixXd::Identity(c.rows(), c.cols()));
 }
 
@@ -130,12 +138,28 @@ Eigen::MatrixXd whitening_at(const Trend& t, const LogFriction& x) {
 // Fisher matrix of the trend's gradient against the realization and trend errors there;
 // infinite where the observables do not move with a friction there.
 Eigen::VectorXd predicted_variance(const Trend& t, const LogFriction& x) {
-  const Eigen::MatrixXd w = whitening_at(t, x) * t.gradient(x);
+  const Eigen::Index m = t.covariance.rows();
+  const Eigen::MatrixXd w = whitening_at(t, x, Eigen::VectorXd::Zero(m)) * t.gradient(x);
   const Eigen::FullPivLU<Eigen::MatrixXd> fisher(w.transpose() * w);
   if (!fisher.isInvertible()) {
     return Eigen::VectorXd::Constant(x.size(), std::numeric_limits<double>::infinity());
   }
   return fisher.inverse().diagonal();
+}
+
+// The experiment's systematic variances' share of a fit's covariance at x: with the GLS
+// weights A = (G^T C^-1 G)^-1 G^T C^-1 its covariance A C A^T splits into the packing's
+// A (1 + leverage) Sigma A^T and the systematic's A S A^T.
+Eigen::MatrixXd systematic_share(const Trend& t, const LogFriction& x,
+                                 const Eigen::VectorXd& systematic) {
+  const Eigen::MatrixXd none = Eigen::MatrixXd::Zero(x.size(), x.size());
+  if (systematic.isZero()) return none;
+  const Eigen::MatrixXd w = whitening_at(t, x, systematic);
+  const Eigen::MatrixXd wg = w * t.gradient(x);
+  const Eigen::FullPivLU<Eigen::MatrixXd> fisher(wg.transpose() * wg);
+  if (!fisher.isInvertible()) return none;
+  const Eigen::MatrixXd a = fisher.inverse() * wg.transpose() * w;
+  return a * systematic.asDiagonal() * a.transpose();
 }
 
 struct OneFit {
@@ -155,7 +179,7 @@ std::pair<LogFriction, LogFriction> bounds(const std::vector<ObservableRun>& run
   return {lo, hi};
 }
 
-OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>& runs, int dims,
+OneFit fit_once(const Target& target, const std::vector<ObservableRun>& runs, int dims,
                 int degree) {
   OneFit f;
   f.trend = fit_trend(runs, dims, degree);
@@ -167,7 +191,9 @@ OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>&
     for (int j = 0; j <= (dims == 2 ? n : 0); ++j) {
       LogFriction x = lo + (hi - lo) * (double(i) / n);
       if (dims == 2) x(1) = lo(1) + (hi(1) - lo(1)) * j / n;
-      const double c = (whitening_at(f.trend, x) * (f.trend.predict(x) - target)).squaredNorm();
+      const double c =
+          (whitening_at(f.trend, x, target.systematic) * (f.trend.predict(x) - target.value))
+              .squaredNorm();
       if (c < best) {
         best = c;
         f.x = x;
@@ -179,13 +205,13 @@ OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>&
   for (int round = 0; round < 2; ++round) {
     ceres::Problem problem;
     auto* cost = new ceres::DynamicNumericDiffCostFunction<Misfit, ceres::CENTRAL>(
-        new Misfit{&f.trend, target, whitening_at(f.trend, f.x), dims});
+        new Misfit{&f.trend, target.value, whitening_at(f.trend, f.x, target.systematic), dims});
     std::vector<double*> blocks;
     for (int d = 0; d < dims; ++d) {
       cost->AddParameterBlock(1);
       blocks.push_back(&p[std::size_t(d)]);
     }
-    cost->SetNumResiduals(int(target.size()));
+    cost->SetNumResiduals(int(target.value.size()));
     problem.AddResidualBlock(cost, nullptr, blocks);
     for (int d = 0; d < dims; ++d) {
       problem.SetParameterLowerBound(blocks[std::size_t(d)], 0, lo(d));
@@ -203,8 +229,17 @@ OneFit fit_once(const Eigen::VectorXd& target, const std::vector<ObservableRun>&
 }
 
 void check_runs(const std::vector<double>& experiment, const std::vector<ObservableRun>& runs,
-                int dims, int degree) {
+                int dims, const ObservableFitOptions& options) {
+  const int degree = options.degree;
   if (degree < 1) throw Error("observable fit: the polynomial degree must be at least 1");
+  const std::vector<double>& systematic = options.experiment_systematic;
+  if (!systematic.empty() && systematic.size() != experiment.size()) {
+    throw Error("observable fit: " + std::to_string(systematic.size()) + " systematic errors for " +
+                std::to_string(experiment.size()) + " observables");
+  }
+  for (double e : systematic)
+    if (!(e >= 0) || !std::isfinite(e))
+      throw Error("observable fit: a systematic error must be finite and not negative");
   if (experiment.size() < std::size_t(dims)) {
     throw Error("observable fit: " + std::to_string(experiment.size()) + " observables for " +
                 std::to_string(dims) + " frictions");
@@ -263,7 +298,8 @@ CrossValidation cross_validate(const std::vector<ObservableRun>& runs, const Tre
         held_out.values.data(), Eigen::Index(held_out.values.size()));
     const Eigen::VectorXd predicted = predicted_variance(whole, truth);
     if (!predicted.allFinite()) continue;  // no slope there: no scale to measure it by
-    const LogFriction e2 = (fit_once(v, others, dims, degree).x - truth).cwiseAbs2();
+    const Target exact{v, Eigen::VectorXd::Zero(v.size())};
+    const LogFriction e2 = (fit_once(exact, others, dims, degree).x - truth).cwiseAbs2();
     error2 += e2;
     ratio2 += e2.cwiseQuotient(predicted);
     ++count;
@@ -323,14 +359,21 @@ std::vector<std::string> common_observables(const SteadyState& experiment,
   return names;
 }
 
-// A fit on the observables common_observables() picks, its `names` set to them.
+// A fit on the observables common_observables() picks, its `names` set to them, with the
+// experiment's systematic errors where it has them.
 template <class Fit>
 auto fit_by_name(const SteadyState& experiment, const std::vector<SteadyStateRun>& runs,
-                 const std::vector<std::string>& only, const Fit& fit) {
+                 const std::vector<std::string>& only, ObservableFitOptions options,
+                 const Fit& fit) {
   std::vector<double> measured;
   std::vector<ObservableRun> twin;
   std::vector<std::string> names = common_observables(experiment, runs, only, measured, twin);
-  auto result = fit(measured, twin);
+  if (!experiment.systematic.empty()) {
+    options.experiment_systematic.clear();
+    for (const std::string& name : names)
+      options.experiment_systematic.push_back(experiment.systematic_of(name));
+  }
+  auto result = fit(measured, twin, options);
   result.names = std::move(names);
   return result;
 }
@@ -352,19 +395,31 @@ std::string method_text(std::size_t observables, const std::string& variables, i
 
 // The GLS fit of `dims` log frictions with its misfit: chi2 over observables - dims dof,
 // and sqrt(chi2 / dof) when above 1, the factor the fit's errors are widened by.
+// The covariance of the log frictions, widened by error_scale, as the experiment's
+// systematic errors' share and the rest, the packing's.
 struct Misfitted {
   Eigen::VectorXd target;
   OneFit f;
   double dof = 0, error_scale = 1;
+  Eigen::MatrixXd covariance, systematic, packing;
 };
 Misfitted fit_checked(const std::vector<double>& experiment, const std::vector<ObservableRun>& runs,
-                      int dims, int degree) {
-  check_runs(experiment, runs, dims, degree);
+                      int dims, const ObservableFitOptions& options) {
+  check_runs(experiment, runs, dims, options);
   Misfitted m;
-  m.target = Eigen::Map<const Eigen::VectorXd>(experiment.data(), Eigen::Index(experiment.size()));
-  m.f = fit_once(m.target, runs, dims, degree);
+  const Eigen::Index n = Eigen::Index(experiment.size());
+  m.target = Eigen::Map<const Eigen::VectorXd>(experiment.data(), n);
+  Target target{m.target, Eigen::VectorXd::Zero(n)};
+  if (!options.experiment_systematic.empty())
+    target.systematic =
+        Eigen::Map<const Eigen::VectorXd>(options.experiment_systematic.data(), n).array().square();
+  m.f = fit_once(target, runs, dims, options.degree);
   m.dof = double(experiment.size()) - dims;
   m.error_scale = m.dof > 0 ? std::max(1.0, std::sqrt(m.f.chi2 / m.dof)) : 1.0;
+  const double widened = m.error_scale * m.error_scale;
+  m.covariance = m.f.covariance * widened;
+  m.systematic = systematic_share(m.f.trend, m.f.x, target.systematic) * widened;
+  m.packing = m.covariance - m.systematic;
   return m;
 }
 
@@ -373,7 +428,7 @@ Misfitted fit_checked(const std::vector<double>& experiment, const std::vector<O
 ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
                                           const std::vector<ObservableRun>& runs,
                                           const ObservableFitOptions& options) {
-  const Misfitted m = fit_checked(experiment, runs, 1, options.degree);
+  const Misfitted m = fit_checked(experiment, runs, 1, options);
   const Eigen::VectorXd& target = m.target;
   const OneFit& f = m.f;
   ObservableFit fit;
@@ -381,7 +436,8 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
   fit.chi2 = f.chi2;
   fit.dof = m.dof;
   fit.error_scale = m.error_scale;
-  fit.gls_sigma = std::sqrt(f.covariance(0, 0)) * fit.error_scale;
+  fit.gls_sigma = std::sqrt(m.covariance(0, 0));
+  fit.systematic_sigma = std::sqrt(m.systematic(0, 0));
   fit.log_mu_s_sigma = fit.gls_sigma;
   double t = student_t_975(f.trend.spare);
   fit.simulations = runs.size();
@@ -406,8 +462,8 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
     const CrossValidation cv = cross_validate(runs, f.trend, 1, options.degree);
     fit.cross_validations = cv.count;
     fit.cross_validated_sigma = cross_validated_sigma(cv, f.trend, f.x, options)(0);
-    if (cv.count > 0 && fit.cross_validated_sigma > fit.log_mu_s_sigma) {
-      fit.log_mu_s_sigma = fit.cross_validated_sigma;
+    if (cv.count > 0 && fit.cross_validated_sigma > std::sqrt(std::max(0.0, m.packing(0, 0)))) {
+      fit.log_mu_s_sigma = std::hypot(fit.cross_validated_sigma, fit.systematic_sigma);
       t = student_t_975(double(cv.count));
     }
   }
@@ -422,15 +478,16 @@ ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
                                            const std::vector<SteadyStateRun>& runs,
                                            const ObservableFitOptions& options,
                                            const std::vector<std::string>& only) {
-  return fit_by_name(experiment, runs, only, [&](const auto& measured, const auto& twin) {
-    return fit_friction_to_observables(measured, twin, options);
-  });
+  return fit_by_name(experiment, runs, only, options,
+                     [](const auto& measured, const auto& twin, const auto& with) {
+                       return fit_friction_to_observables(measured, twin, with);
+                     });
 }
 
 JointObservableFit fit_frictions_to_observables(const std::vector<double>& experiment,
                                                 const std::vector<ObservableRun>& runs,
                                                 const ObservableFitOptions& options) {
-  const Misfitted m = fit_checked(experiment, runs, 2, options.degree);
+  const Misfitted m = fit_checked(experiment, runs, 2, options);
   const Eigen::VectorXd& target = m.target;
   const OneFit& f = m.f;
   JointObservableFit fit;
@@ -439,8 +496,9 @@ JointObservableFit fit_frictions_to_observables(const std::vector<double>& exper
   fit.chi2 = f.chi2;
   fit.dof = m.dof;
   fit.error_scale = m.error_scale;
-  Eigen::Matrix2d c = f.covariance * fit.error_scale * fit.error_scale;
+  Eigen::Matrix2d c = m.covariance;
   fit.gls_sigma = {std::sqrt(c(0, 0)), std::sqrt(c(1, 1))};
+  fit.systematic_sigma = {std::sqrt(m.systematic(0, 0)), std::sqrt(m.systematic(1, 1))};
   double dof = f.trend.spare;
   fit.simulations = runs.size();
   const Eigen::VectorXd model = f.trend.predict(f.x);
@@ -448,18 +506,19 @@ JointObservableFit fit_frictions_to_observables(const std::vector<double>& exper
     fit.model.push_back(model(o));
     fit.scatter.push_back(f.trend.scatter(o));
   }
-  // Each log friction's error is the larger of the fit's and the cross-validation's; the
-  // correlation is the fit's.
+  // Each log friction's packing error is the larger of the fit's and the cross-validation's,
+  // the experiment's systematic share beside it; the correlation is the fit's.
   if (options.cross_validate) {
     const CrossValidation cv = cross_validate(runs, f.trend, 2, options.degree);
     const LogFriction sigma = cross_validated_sigma(cv, f.trend, f.x, options);
     fit.cross_validations = cv.count;
     fit.cross_validated_sigma = {sigma(0), sigma(1)};
-    if (cv.count > 0 && (sigma(0) > fit.gls_sigma[0] || sigma(1) > fit.gls_sigma[1])) {
+    const Eigen::Vector2d packing = m.packing.diagonal().cwiseMax(1e-300).cwiseSqrt();
+    if (cv.count > 0 && (sigma(0) > packing(0) || sigma(1) > packing(1))) {
       Eigen::Matrix2d scale = Eigen::Matrix2d::Zero();
       for (int d = 0; d < 2; ++d)
-        scale(d, d) = std::max(1.0, sigma(d) / fit.gls_sigma[std::size_t(d)]);
-      c = scale * c * scale;
+        scale(d, d) = std::max(1.0, sigma(d) / packing(d));
+      c = scale * m.packing * scale + m.systematic;
       dof = double(cv.count);
     }
   }
@@ -489,9 +548,10 @@ JointObservableFit fit_frictions_to_steady_state(const SteadyState& experiment,
                                                  const std::vector<SteadyStateRun>& runs,
                                                  const ObservableFitOptions& options,
                                                  const std::vector<std::string>& only) {
-  return fit_by_name(experiment, runs, only, [&](const auto& measured, const auto& twin) {
-    return fit_frictions_to_observables(measured, twin, options);
-  });
+  return fit_by_name(experiment, runs, only, options,
+                     [](const auto& measured, const auto& twin, const auto& with) {
+                       return fit_frictions_to_observables(measured, twin, with);
+                     });
 }
 
 }  // namespace granmem

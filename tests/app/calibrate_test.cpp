@@ -316,6 +316,14 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   EXPECT_NE(json.find("\"deposit\": \"experiment\""), std::string::npos) << json;
   EXPECT_EQ(json_value(json, "placed_cycle"), 1) << json;
   expect_fit_in_its_interval(json);
+  // The placed packing read back at its frame, over every packing at the friction nearest the
+  // fit, less the experiment's: carried as the experiment's systematic errors, their share of
+  // the fit's error said.
+  EXPECT_NE(r.out.find("carried as the experiment's systematic errors"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(json_value(json, "placed_frame_runs"), 2) << json;
+  EXPECT_GT(json_value(json, "systematic_sigma"), 0) << json;
+  EXPECT_LE(json_value(json, "systematic_sigma"), json_value(json, "gls_sigma")) << json;
   // Where the runs start, the packing's height: the twin's placed packings at the true
   // friction against the experiment's there (after cycle 1, numbered so), and poured
   // packings against the experiment's before its first cycle.

@@ -35,6 +35,16 @@ struct Synthetic {
     const double shared = normal(random);
     return {0.001 * shared, -0.2 * shared + 0.1 * normal(random), 0.0004 * normal(random)};
   }
+  // `packings` packings (seeds 1, 2, ...), each run at every one of `frictions`.
+  std::vector<ObservableRun> twin(const std::vector<double>& frictions, int packings) {
+    std::vector<ObservableRun> runs;
+    for (std::uint64_t seed = 1; seed <= std::uint64_t(packings); ++seed) {
+      const std::vector<double> p = packing();
+      for (double mu : frictions)
+        runs.push_back({mu, seed, values(mu, p)});
+    }
+    return runs;
+  }
   // A truth drawn uniformly in ln mu_s between range[0] and range[1].
   double log_uniform(const std::array<double, 2>& range) {
     const double u = std::uniform_real_distribution<>()(random);
@@ -62,12 +72,7 @@ TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
   ObservableFitOptions without_cv;
   without_cv.cross_validate = false;
   for (int trial = 0; trial < 150; ++trial) {
-    std::vector<ObservableRun> runs;
-    for (std::uint64_t seed : {1, 2}) {
-      const std::vector<double> packing = s.packing();
-      for (double mu : frictions)
-        runs.push_back({mu, seed, s.values(mu, packing)});
-    }
+    const std::vector<ObservableRun> runs = s.twin(frictions, 2);
     const double truth = s.log_uniform({0.07, 0.4});
     const std::vector<double> experiment = s.values(truth, s.packing());
     const ObservableFit fit = fit_friction_to_observables(experiment, runs);
@@ -82,6 +87,75 @@ TEST(ObservableFit, TheIntervalHoldsTheTruthAtItsRateOnSyntheticTwins) {
               tally.coverage(), without_cv_tally.coverage(), tally.mean_ln_width());
   EXPECT_GE(tally.coverage(), 0.88) << tally.held << " of " << tally.trials;
   EXPECT_LT(tally.mean_ln_width(), 1.0);  // informative: well under a factor e
+}
+
+// An experiment measured with errors the twin cannot reproduce (an offset of each
+// observable, drawn anew per experiment at three times its packing's noise): given as the
+// experiment's systematic errors its interval holds the truth at its rate; given as zero the
+// fit is the one without them.
+TEST(ObservableFit, AnExperimentsSystematicErrorsAreCarriedIntoItsInterval) {
+  Synthetic s{std::mt19937_64(23)};
+  const std::vector<double> frictions{0.05, 0.1, 0.2, 0.3, 0.5};
+  const std::vector<double> systematic{0.004, 0.6, 0.0025};
+  DesignTally carried, ignored;
+  for (int trial = 0; trial < 150; ++trial) {
+    const std::vector<ObservableRun> runs = s.twin(frictions, 2);
+    const double truth = s.log_uniform({0.07, 0.4});
+    std::vector<double> experiment = s.values(truth, s.packing());
+    for (std::size_t k = 0; k < experiment.size(); ++k)
+      experiment[k] += systematic[k] * s.normal(s.random);
+    ObservableFitOptions with;
+    with.experiment_systematic = systematic;
+    const ObservableFit fit = fit_friction_to_observables(experiment, runs, with);
+    const ObservableFit plain = fit_friction_to_observables(experiment, runs);
+    carried.add(fit, truth);
+    ignored.add(plain, truth);
+    EXPECT_GT(fit.systematic_sigma, 0);
+    EXPECT_LE(fit.systematic_sigma, fit.gls_sigma * (1 + 1e-9));
+    if (trial < 10) {
+      with.experiment_systematic.assign(3, 0.0);
+      const ObservableFit zero = fit_friction_to_observables(experiment, runs, with);
+      EXPECT_EQ(zero.mu_s, plain.mu_s);
+      EXPECT_EQ(zero.mu_s_ci95, plain.mu_s_ci95);
+      EXPECT_EQ(zero.systematic_sigma, 0);
+    }
+  }
+  // Ignored, such offsets mostly show as a misfit, which widens the interval instead.
+  std::printf(
+      "with the systematic errors carried: coverage %.3f, mean ln width %.3f; "
+      "ignored: %.3f, %.3f\n",
+      carried.coverage(), carried.mean_ln_width(), ignored.coverage(), ignored.mean_ln_width());
+  EXPECT_GE(carried.coverage(), 0.9) << carried.held << " of " << carried.trials;
+  ObservableFitOptions mismatched;
+  mismatched.experiment_systematic = {0.001};
+  const std::vector<ObservableRun> runs{{0.1, 1, {0.58, 7, 0.01}},
+                                        {0.2, 1, {0.57, 8, 0.012}},
+                                        {0.3, 1, {0.565, 8.5, 0.013}},
+                                        {0.5, 1, {0.56, 9, 0.014}}};
+  EXPECT_THROW(fit_friction_to_observables({0.57, 8, 0.012}, runs, mismatched), Error);
+}
+
+// One observable, no misfit to widen by: the experiment's systematic error s adds to the
+// fit's in quadrature, s / |slope| in ln mu_s, and leaves the fit where it was.
+TEST(ObservableFit, OneObservablesSystematicErrorAddsInQuadrature) {
+  const double slope = 0.02;  // per unit of ln mu_s
+  std::vector<ObservableRun> runs;
+  int k = 0;
+  for (std::uint64_t seed : {1, 2})
+    for (double mu : {0.05, 0.1, 0.2, 0.4})
+      runs.push_back({mu, seed, {0.6 + slope * std::log(mu) + 0.0004 * ((k++ % 3) - 1)}});
+  ObservableFitOptions linear, with;
+  linear.degree = with.degree = 1;
+  linear.cross_validate = with.cross_validate = false;
+  with.experiment_systematic = {0.003};
+  const std::vector<double> experiment{0.6 + slope * std::log(0.15)};
+  const ObservableFit plain = fit_friction_to_observables(experiment, runs, linear);
+  const ObservableFit fit = fit_friction_to_observables(experiment, runs, with);
+  EXPECT_NEAR(fit.mu_s, plain.mu_s, 1e-6);
+  EXPECT_NEAR(fit.systematic_sigma, 0.003 / slope, 0.003 / slope * 0.02);
+  EXPECT_NEAR(fit.gls_sigma * fit.gls_sigma,
+              plain.gls_sigma * plain.gls_sigma + fit.systematic_sigma * fit.systematic_sigma,
+              1e-3 * fit.gls_sigma * fit.gls_sigma);
 }
 
 // Two designs of one cost on the same synthetic twins: `packings` x `first`, then `added`
@@ -385,6 +459,17 @@ TEST(ObservableFit, ByNameTheFitUsesWhatTheExperimentAndEveryRunHave) {
   const ObservableFit two = fit_friction_to_steady_state(steady(experiment.values, 5), twin, {},
                                                          {"packing_fraction", "rot_disp"});
   EXPECT_EQ(two.names, (std::vector<std::string>{"packing_fraction", "rot_disp"}));
+  // The experiment's systematic errors travel with it, by name.
+  SteadyState measured = steady(experiment.values, 3);
+  measured.systematic = {0.0, 0.0, 0.002};
+  // The default options, with the same errors by position.
+  const ObservableFitOptions same_errors{2, true, true, measured.systematic};
+  const ObservableFit carried = fit_friction_to_steady_state(measured, twin);
+  EXPECT_GT(carried.systematic_sigma, 0);
+  EXPECT_DOUBLE_EQ(carried.mu_s, fit_friction_to_observables(
+                                     {experiment.values.begin(), experiment.values.begin() + 3},
+                                     columns, same_errors)
+                                     .mu_s);
 }
 
 // Four observables that move with both frictions, as in the DEM: packing fraction and

@@ -99,9 +99,14 @@ struct SteadyState {
   // Each one's change across the window (its least-squares slope per cycle times the
   // window's cycles): a steady state's is within the scatter of one packing's value.
   std::vector<double> drift;
+  // An experiment's: each value's standard error beyond one packing's scatter, what the twin
+  // cannot reproduce of how it was measured (a placed twin's read back at its frame). Empty:
+  // none.
+  std::vector<double> systematic;
   // The value of `name`, NaN when the run has none.
   double operator[](const std::string& name) const;
   double drift_of(const std::string& name) const;
+  double systematic_of(const std::string& name) const;  // 0 where none
 };
 // What is known of a packing's grains beyond what a scan locates.
 struct KnownGrains {

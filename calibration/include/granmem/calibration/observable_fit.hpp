@@ -33,15 +33,22 @@ struct ObservableFitOptions {
   // slope against their scatter), times the predicted error at the fit (true); or as
   // their plain RMS, wherever the runs are (false).
   bool cross_validation_by_friction = true;
+  // Each experiment value's standard error beyond one packing's scatter (SteadyState::
+  // systematic), in the experiment's order, added to its covariance; empty: none. It is not
+  // one packing's error, so the cross-validation across packings does not stand in for it:
+  // the interval takes the larger of the fit's packing error and the cross-validated one,
+  // and this error's share beside it.
+  std::vector<double> experiment_systematic;
 };
 
 struct ObservableFit {
   double mu_s = 0;
   std::array<double, 2> mu_s_ci95{0, 0};
-  double log_mu_s_sigma = 0;  // standard error of ln(mu_s) that sets the interval
-  double chi2 = 0, dof = 0;   // at the fit; dof = observables - 1
-  double error_scale = 1;     // sqrt(chi2 / dof) when above 1
-  double gls_sigma = 0;       // the GLS fit's own standard error of ln(mu_s), widened on a misfit
+  double log_mu_s_sigma = 0;    // standard error of ln(mu_s) that sets the interval
+  double chi2 = 0, dof = 0;     // at the fit; dof = observables - 1
+  double error_scale = 1;       // sqrt(chi2 / dof) when above 1
+  double gls_sigma = 0;         // the GLS fit's own standard error of ln(mu_s), widened on a misfit
+  double systematic_sigma = 0;  // the experiment's systematic errors' share of gls_sigma
   double cross_validated_sigma = 0;  // one packing's error in ln(mu_s) at the fit, held out
   std::size_t cross_validations = 0;
   std::vector<double> scatter;     // per observable: the runs' scatter about the trend
@@ -78,7 +85,8 @@ struct SteadyStateRun {
 };
 
 // The same fit on the observables that the experiment and every run have, by name, in the
-// experiment's order (a scan has no lid height, a run without axes no rotations; the lid's
+// experiment's order, with the experiment's systematic errors where it has them (a scan has
+// no lid height, a run without axes no rotations; the lid's
 // packing_fraction is left out where height_packing_fraction, the same from positions, is
 // there), or on `only` where it is not empty (Error naming one that is missing). The
 // fit's `names` says which were used.
@@ -103,6 +111,7 @@ struct JointObservableFit {
   double chi2 = 0, dof = 0;  // dof = observables - 2
   double error_scale = 1;
   std::array<double, 2> gls_sigma{0, 0}, cross_validated_sigma{0, 0};
+  std::array<double, 2> systematic_sigma{0, 0};  // the experiment's systematic errors' share
   std::size_t cross_validations = 0;
   std::vector<double> scatter, model;
   std::vector<std::string> names;

@@ -896,7 +896,7 @@ SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableF
     p.curve_mu_s = fit.curve_mu_s;
     p.curve = fit.curve[k];
     p.experiment = experiment[name];
-    p.experiment_error = fit.scatter[k];
+    p.experiment_error = std::hypot(fit.scatter[k], experiment.systematic_of(name));
     panels.push_back(std::move(p));
     double twin_drift = 0;
     for (const SteadyStateRun& r : runs)
@@ -907,10 +907,13 @@ SteadyStateOutputs write_steady_state_fit(const fs::path& out, const ObservableF
                         " across the window (the twin's runs' mean; one packing's scatter " +
                         number_text(fit.scatter[k]) + "): not yet a steady state");
     }
-    o.observables[name] = {
-        {"experiment", experiment[name]},       {"drift_over_window", experiment.drift_of(name)},
-        {"twin_drift_over_window", twin_drift}, {"model_at_fit", fit.model[k]},
-        {"packing_scatter", fit.scatter[k]},    {"log_mu_s_resolution", fit.resolution[k]}};
+    o.observables[name] = {{"experiment", experiment[name]},
+                           {"drift_over_window", experiment.drift_of(name)},
+                           {"twin_drift_over_window", twin_drift},
+                           {"model_at_fit", fit.model[k]},
+                           {"packing_scatter", fit.scatter[k]},
+                           {"log_mu_s_resolution", fit.resolution[k]},
+                           {"experiment_systematic", experiment.systematic_of(name)}};
   }
   if (const std::string edge = design_edge_note(fit.mu_s, runs); !edge.empty())
     o.notes.push_back(edge);
@@ -1363,10 +1366,10 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
 void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                       CalibrateSummary& s, std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  const SteadyState measured = twin.measured_steady_state();
   ScanNoise noise;
   std::vector<SteadyStateRun> runs;
   const ObservableFit fit = steady_state_fit(twin, specs, runs, &noise);
+  const SteadyState measured = with_systematic(twin.measured_steady_state(), noise.placed);
   const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed()};
   const FrictionRunSpec best = compared_run(twin, specs, at_fit, [&](const FrictionRunSpec& r) {
     return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];

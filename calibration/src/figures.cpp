@@ -320,7 +320,7 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
             "packing)\", "
          << quoted(name + ".dat") << " index " << 2 * p + 1
          << " using 1:2 with lines lw 2 lc rgb \"#404040\" title \"trend\", "
-         << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- one packing\", "
+         << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- packing, systematic\", "
          << "NaN with lines lw 8 lc rgb \"#f4a582\" title \"fitted mu_s, 95 %\""
          << (std::isfinite(true_mu_s)
                  ? ", NaN with lines lw 2 dt 2 lc rgb \"black\" title \"true mu_s\""

@@ -64,7 +64,8 @@ std::vector<std::filesystem::path> plot_curves(
 
 // A friction fit on steady-state observables, one panel per observable against mu_s (log):
 // the twin's runs (one colour per packing), the trend fitted through them, the
-// experiment's value as a band (+- one packing's scatter), the fitted mu_s and its 95 %
+// experiment's value as a band (+- one packing's scatter and the experiment's systematic
+// error in quadrature), the fitted mu_s and its 95 %
 // interval as a shaded band, and the true mu_s of a pseudo-experiment (NaN: unknown).
 struct ObservablePanel {
   std::string label;  // the observable, with its unit

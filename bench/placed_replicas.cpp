@@ -16,6 +16,7 @@
 #include <string>
 
 #include "bench_options.hpp"
+#include "granmem/calibration/cycle_observables.hpp"
 #include "granmem/core/trajectory_store.hpp"
 #include "granmem/sim/deposit.hpp"
 #include "granmem/sim/placed_packing.hpp"
@@ -47,15 +48,13 @@ int main(int argc, char** argv) {
   if (std::isfinite(damping)) deposit.placed_settling_damping = damping;
   if (!std::isfinite(jitter)) jitter = 1e-4 * 2 * deposit.radius;
   const TrajectoryReader run(argv[1]);
-  const auto& steps = run.steps();
-  const std::size_t frame =
-      cycle < 0 ? 0 : std::size_t(std::find(steps.begin(), steps.end(), cycle) - steps.begin());
-  if (frame >= steps.size()) {
+  const std::optional<std::size_t> frame = cycle < 0 ? 0 : frame_of_cycle(run, cycle);
+  if (!frame) {
     std::fprintf(stderr, "placed_replicas: %s has no frame of cycle %lld\n", argv[1],
                  static_cast<long long>(cycle));
     return 2;
   }
-  const Grains placed = grains_of_frame(run, frame, deposit, physics);
+  const Grains placed = grains_of_frame(run, *frame, deposit, physics);
   double sum = 0, sum2 = 0, lid = 0, lid2 = 0;
   for (int seed = 1; seed <= replicas; ++seed) {
     DepositSummary s;

@@ -970,16 +970,16 @@ std::vector<FrictionRunSpec> runs_nearest(const std::vector<SteadyStateRun>& run
   return at;
 }
 
-// The scans' locating error read from their contacts (contact_locating_error.hpp) against
-// the twin's run nearest `mu_s`: for scans of grains known to be alike (a simulated
-// experiment's positions are exact), poured or placed (a placed run's distances are the
-// DEM's once settled: on 0.31's scans 7.13 and 15.1 um against a placed run, 7.19 and 15.1
-// against a poured one); NaN errors elsewhere. In metres.
 // The scans' errors read from their contacts against the twin's run nearest (mu_s, mu_r).
 struct ContactsReading {
   ContactLocatingError positions;
   DisplacementError displacements;
 };
+// The scans' locating error read from their contacts (contact_locating_error.hpp) against
+// the twin's run nearest `mu_s`: for scans of grains known to be alike (a simulated
+// experiment's positions are exact), poured or placed (a placed run's distances are the
+// DEM's once settled: on 0.31's scans 7.13 and 15.1 um against a placed run, 7.19 and 15.1
+// against a poured one); NaN errors elsewhere. In metres.
 ContactsReading errors_from_contacts(const Twin& twin, const std::vector<SteadyStateRun>& runs,
                                      double mu_s, double mu_r) {
   const KnownGrains known = twin.known_grains();
@@ -1066,6 +1066,7 @@ struct ScanNoise {
   ContactLocatingError contacts;
   DisplacementError displacements;
   PlacedReadBack placed;
+  SteadyState experiment;  // as fitted: with the read-back as its systematic errors
 };
 
 template <class E>
@@ -1167,6 +1168,7 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
     experiment = with_systematic(experiment, found.placed);
     fit = fit_to(experiment, runs, only);
   }
+  found.experiment = experiment;
   if (only.empty()) found.limited = noise_limited(twin, fit.names, fit.scatter, found);
   std::vector<std::string> kept;
   for (const std::string& name : fit.names) {
@@ -1369,7 +1371,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   ScanNoise noise;
   std::vector<SteadyStateRun> runs;
   const ObservableFit fit = steady_state_fit(twin, specs, runs, &noise);
-  const SteadyState measured = with_systematic(twin.measured_steady_state(), noise.placed);
+  const SteadyState& measured = noise.experiment;
   const FrictionRunSpec at_fit{three_digits(fit.mu_s), twin.seed()};
   const FrictionRunSpec best = compared_run(twin, specs, at_fit, [&](const FrictionRunSpec& r) {
     return r.mu_s >= fit.mu_s_ci95[0] && r.mu_s <= fit.mu_s_ci95[1];

@@ -394,9 +394,9 @@ std::string method_text(std::size_t observables, const std::string& variables, i
 }
 
 // The GLS fit of `dims` log frictions with its misfit: chi2 over observables - dims dof,
-// and sqrt(chi2 / dof) when above 1, the factor the fit's errors are widened by.
-// The covariance of the log frictions, widened by error_scale, as the experiment's
-// systematic errors' share and the rest, the packing's.
+// and sqrt(chi2 / dof) when above 1, the factor the fit's errors are widened by; the
+// covariance of the log frictions, so widened, split into the experiment's systematic
+// errors' share and the rest, the packing's.
 struct Misfitted {
   Eigen::VectorXd target;
   OneFit f;

@@ -45,8 +45,8 @@ void add_link_options(CLI::App* cmd, LinkArgs& args) {
   cmd->add_option("--container-size", args.container_size,
                   "the container's edges LX,LY,LZ with a unit, its position found from the "
                   "packing's extent in the first scan (grains pressed into it touch its floor "
-                  "and walls: centred between the walls across x and y, its lowest surface "
-                  "on the floor); instead of --container");
+                  "and walls: centred between the walls across x and y, its bottom layer "
+                  "resting on the floor); instead of --container");
   cmd->add_option("--first-cycle", args.first_cycle,
                   "the cycle at whose end the first scan was taken, where the scans do not say "
                   "theirs: frames numbered from it in the order given (the last 10 of 500: "

@@ -214,7 +214,7 @@ TEST_F(LinkCommandTest, PositionsAreStoredInTheContainersFrame) {
     }
   }
   // Found from the packing's extent: across x and y the surfaces' extent in the first scan
-  // centred in the container, along z the lowest surface on its floor.
+  // centred in the container, along z the bottom layer (exact here) on its floor.
   granmem_ok({"link", "scan0.h5", "scan1.csv", "--out", "found.h5", "--container-size", "5,5,7cm"});
   const Trajectories found = read_trajectories(in_work("found.h5"));
   ASSERT_TRUE(found.header.box.has_value());

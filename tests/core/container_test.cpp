@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "granmem/core/trajectories.hpp"
@@ -52,6 +53,31 @@ TEST(ContainerFromExtent, SmallLocatedRadiiAndNoiseCancelBetweenTheWalls) {
     // inside the wall.
     const double lowest_x = scan.frames[0].position.col(0).minCoeff() - 0.42;
     EXPECT_GT(lowest_x - lower.x(), 0.04);
+  }
+}
+
+// Along z only the floor is a wall. A scan's noise (here a tenth of a radius, with the
+// located radii's own) pushes the lowest grain ~2.5 sigma below the floor, where the
+// container used to be registered; the bottom layer's median rests on it, and a stray
+// detection a diameter below the floor does not move it.
+TEST(ContainerFromExtent, TheFloorIsWhereTheBottomLayerRestsNotItsLowestGrain) {
+  const Eigen::Vector3d lower(3, -2, 1), edges(10, 10, 12);
+  const double noise = 0.02;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    Trajectories scan = column_in_container(lower, 0.5, noise, seed);
+    std::mt19937 rng(seed + 100);
+    std::normal_distribution<double> radius_error(0.0, noise);
+    for (double& r : scan.header.radius)
+      r += radius_error(rng);
+    scan.frames[0].position(0, 2) = lower.z() - 0.5;  // the stray: its bottom a diameter down
+    const Box found = container_from_extent(scan, edges);
+    // The median of 100 bottoms, each off by hypot(noise, noise): ~0.0035 standard error.
+    EXPECT_NEAR(found.lower.z(), lower.z(), 0.011) << "seed " << seed;
+    double lowest_real = std::numeric_limits<double>::infinity();
+    for (Eigen::Index k = 1; k < scan.frames[0].position.rows(); ++k)
+      lowest_real =
+          std::min(lowest_real, scan.frames[0].position(k, 2) - scan.header.radius[std::size_t(k)]);
+    EXPECT_LT(lowest_real - lower.z(), -0.04) << "the lowest surface would be well below";
   }
 }
 

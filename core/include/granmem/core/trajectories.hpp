@@ -96,9 +96,9 @@ void register_to_container(Trajectories& run, const Box& container);
 // 4 d^2) of the surfaces nearest that wall (x - r, ..., or x + r), not the one
 // extreme grain that noise pushes outward. Across x and y the packing is centred between
 // the walls, so that radii located too small or too large, and noise, alike on both sides,
-// cancel; along z the floor is at the lowest surface (z - r; the lid is free, so the top is
-// no wall, and the radii's error stays: noise pushing the lowest grain outward offsets
-// some of it). Error for a run without positions.
+// cancel; along z the floor is where the bottom layer rests, the median of its grains' lowest
+// surfaces (z - r; the lid is free, so the top is no wall), not the lowest one, which noise
+// pushes below the floor. Error for a run without positions.
 Box container_from_extent(const Trajectories& run, const Eigen::Vector3d& edges);
 
 // Checks a header for consistency (sizes, unique ids, known units); throws Error naming `where`.

@@ -77,7 +77,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   add_drift_flags(cmd, args->subtract_drift);
   cmd->add_option("--degree", args->degree,
                   "degree of the polynomial in log mu_s through the runs' summaries; 0: 3 "
-                  "for mu_s alone on a twin placed from a simulation's exact frame, else 2")
+                  "for mu_s alone on a twin placed from the experiment's packing, else 2")
       ->capture_default_str();
   cmd->add_option("--replicas", args->replicas,
                   "packings per friction (seeds seed, seed+1, ...): their scatter is the "
@@ -87,9 +87,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_option("--refine", args->refine,
                   "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
                   "--replicas design, each its own seed, and the fit made again on every run "
-                  "(they measure one packing's scatter where the experiment is); default 0, but "
-                  "3 for a steady-state fit of mu_s with --mu-s and --replicas left out (placed "
-                  "4)")
+                  "(they measure one packing's scatter where the experiment is; placed from scans, "
+                  "the last is the placement probe: the first placed again from its own frame "
+                  "moved by the scans' error); default 0, but 3 for a steady-state fit of mu_s "
+                  "with --mu-s and --replicas left out (placed 4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "

@@ -34,6 +34,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// The placement probe's draws of the scans' error: seeds apart from the replicas' jitters.
+constexpr std::uint64_t kProbeSeed = 20261128;
+
 // Six digits, as labels and messages show a friction.
 std::string number_text(double x) {
   char text[32];
@@ -344,6 +347,23 @@ FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const Run
 
 // Everything the calibration's stages share: the experiment, the twin's physics and
 // protocol, and how to run the twin (reusing what a stopped call finished).
+// The placed packing's grain count and a digest of its grains' positions.
+std::string placed_identity(const Grains& grains) {
+  std::uint64_t digest = kFnv1aBasis;
+  for (const Eigen::Vector3d& x : grains.x)
+    digest = fnv1a(x.data(), sizeof(double) * 3, digest);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
+  return std::to_string(grains.size()) + " grains, positions digest " + hex;
+}
+
+// The placement probe's run and the twin's run it was placed from (Twin::run_placement_probe).
+struct PlacementProbe {
+  FrictionRunSpec source;
+  fs::path path;
+  Eigen::Vector3d error;  // m, the scans' locating error it was moved by
+};
+
 class Twin {
  public:
   Twin(const CalibrateOptions& options, const TrajectoryReader& experiment)
@@ -428,8 +448,7 @@ class Twin {
   // The trend's degree (CalibrateOptions::degree; 0: by the twin).
   int trend_degree() const {
     if (o_.degree > 0) return o_.degree;
-    const bool exact = placed_ && exact_packing_at(experiment_, placed_cycle_);
-    return exact && !o_.joint() && o_.mu_s.size() >= 4 ? 3 : 2;
+    return placed_ && !o_.joint() && o_.mu_s.size() >= 4 ? 3 : 2;
   }
   const TrajectoryReader& experiment() const { return experiment_; }
   // The seeds after the design's: packings none of its runs pour.
@@ -578,15 +597,48 @@ class Twin {
                                                      : kPlacedJitterDiameters * 2 * deposit_.radius;
   }
 
-  // The placed packing's grain count and a digest of its grains' positions.
-  std::string placed_identity() const {
-    std::uint64_t digest = kFnv1aBasis;
-    for (const Eigen::Vector3d& x : placed_->x)
-      digest = fnv1a(x.data(), sizeof(double) * 3, digest);
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(digest));
-    return std::to_string(placed_->size()) + " grains, positions digest " + hex;
+  // A placed twin's placed from scans (their frame carries locating errors), not from a
+  // simulation's exact frame.
+  bool placed_from_scans() const {
+    return placed_ && !exact_packing_at(experiment_, placed_cycle_);
   }
+
+  // The placement probe: the run `source` placed once more, from its own frame of the placed
+  // cycle moved by a draw of the scans' locating error `error` (m, along x, y, z), at its
+  // friction and seed, in its own folder (probe/). Its window less its source's is what
+  // placing from such a frame does to the twin, which the source's replicas (jittered by
+  // 0.5 um) do not see (docs/CALIBRATION.md, "The placement probe").
+  void run_placement_probe(const FrictionRunSpec& source, const Eigen::Vector3d& error) {
+    const TrajectoryReader from(path(source));
+    const std::optional<std::size_t> frame = frame_of_cycle(from, placed_cycle_);
+    if (!frame) {
+      throw Error(path(source).string() + ": no frame of cycle " + std::to_string(placed_cycle_) +
+                  " to place the placement probe from");
+    }
+    const Grains moved = jittered(grains_of_frame(from, *frame, deposit_, physics_), error,
+                                  kProbeSeed + source.seed, deposit_);
+    FrictionSeriesOptions series = series_;
+    series.dir = o_.out / "probe";
+    series.protocol.parameters["calibrate/placed_from"] = placed_identity(moved);
+    std::ostringstream of;
+    of << path(source).filename().string() << " moved by " << error.x() << ", " << error.y() << ", "
+       << error.z() << " m";
+    series.protocol.parameters["calibrate/probe_of"] = of.str();
+    probe_ = PlacementProbe{source, friction_run_path(series.dir, source), error};
+    if (finished_run(probe_->path, series.protocol.parameters, series.protocol.cycles)) {
+      say("reusing the placement probe " + probe_->path.string());
+      return;
+    }
+    say("the placement probe: " + of.str() + ", 1 run");
+    fs::create_directories(series.dir);
+    run_friction_series(
+        {source}, series,
+        [&](const FrictionRunSpec& spec, int cores) { return placed_start(moved, spec, cores); },
+        [&](std::size_t, const CyclicProgress& p) {
+          if (o_.progress) o_.progress(source, p);
+        });
+  }
+  const std::optional<PlacementProbe>& placement_probe() const { return probe_; }
 
   // Shared packings: one per seed (the design's, or `more`), kept in the output folder so
   // that a second call reuses them.
@@ -637,13 +689,7 @@ class Twin {
       if (o_.preparation == TwinPreparation::shared) {
         return with_frictions(shared_.at(spec.seed), spec, series_.walls_follow);
       }
-      if (o_.preparation == TwinPreparation::experiment) {
-        DepositOptions settling = deposit_;
-        settling.threads = Simulation::threads_on_own_cores(placed_->size(), cores);
-        return settled_packing(jittered(*placed_, placed_jitter_, spec.seed, deposit_), settling,
-                               with_frictions(physics_, spec, series_.walls_follow),
-                               GrainPlacement::at_rest);
-      }
+      if (o_.preparation == TwinPreparation::experiment) return placed_start(*placed_, spec, cores);
       return deposit_at_friction(deposit_, physics_, spec, series_.walls_follow, cores);
     };
     run_friction_series(todo, series_, start, [&](std::size_t k, const CyclicProgress& p) {
@@ -658,6 +704,15 @@ class Twin {
   }
 
  private:
+  // A run's packing placed at `grains` (its seed's jitter added) and settled at its friction.
+  Simulation placed_start(const Grains& grains, const FrictionRunSpec& spec, int cores) const {
+    DepositOptions settling = deposit_;
+    settling.threads = Simulation::threads_on_own_cores(grains.size(), cores);
+    return settled_packing(jittered(grains, placed_jitter_, spec.seed, deposit_), settling,
+                           with_frictions(physics_, spec, series_.walls_follow),
+                           GrainPlacement::at_rest);
+  }
+
   FrictionSeriesOptions series_options() const {
     FrictionSeriesOptions series;
     series.dir = o_.out / "runs";
@@ -681,7 +736,7 @@ class Twin {
       series.protocol.parameters["simulate/mu-s"] = settings_.at("mu-s");
     series.protocol.parameters["calibrate/deposit"] = preparation_name(o_.preparation);
     if (placed_) {  // runs placed from another experiment's packing are other runs
-      series.protocol.parameters["calibrate/placed_from"] = placed_identity();
+      series.protocol.parameters["calibrate/placed_from"] = placed_identity(*placed_);
       series.protocol.parameters["calibrate/placed_jitter"] = number_text(placed_jitter_) + " m";
       series.protocol.parameters["calibrate/placed_settling_damping"] =
           number_text(deposit_.placed_settling_damping) + " 1/s";
@@ -723,17 +778,23 @@ class Twin {
   FrictionSeriesOptions series_;
   std::vector<std::uint64_t> seeds_;
   std::map<std::uint64_t, Simulation> shared_;
-  std::optional<Grains> placed_;   // --deposit experiment: its frame's grains
+  std::optional<Grains> placed_;  // --deposit experiment: its frame's grains
+  std::optional<PlacementProbe> probe_;
   double placed_jitter_ = 0;       // m
   std::int64_t placed_cycle_ = 0;  // the experiment's cycle they were placed from
 };
+
+// The simulations the fit stands on: the twin's runs and its placement probe.
+std::size_t simulations_fitted(const Twin& twin, const std::vector<FrictionRunSpec>& specs) {
+  return specs.size() + (twin.placement_probe() ? 1 : 0);
+}
 
 std::size_t simulations_with(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                              const FrictionRunSpec& best) {
   const bool simulated = std::any_of(specs.begin(), specs.end(), [&](const auto& r) {
     return r.mu_s == best.mu_s && r.seed == best.seed && r.mu_r == best.mu_r;
   });
-  return specs.size() + (twin.options().fit_only || simulated ? 0 : 1);
+  return simulations_fitted(twin, specs) + (twin.options().fit_only || simulated ? 0 : 1);
 }
 
 // The run the experiment is compared with: the twin's run nearest the fit (in ln mu_s, and
@@ -829,6 +890,27 @@ std::vector<SteadyStateRun> twin_steady_states(
     runs.push_back({spec.mu_s, spec.seed, state, spec.mu_r});
   }
   return runs;
+}
+
+// The placement probe's window less its source run's, both measured as the twin's runs are
+// (twin_steady_states, the same draws of the scans' error); empty without a probe.
+SteadyState placement_probe_effect(const Twin& twin, const Eigen::Vector3d& position_noise,
+                                   const Eigen::Vector3d& displacement_noise) {
+  const std::optional<PlacementProbe>& probe = twin.placement_probe();
+  if (!probe) return {};
+  ObservableOptions observe = twin.observe;
+  observe.position_noise = displacement_noise;
+  const auto measured = [&](const fs::path& path) {
+    const TrajectoryReader r(path);
+    return steady_state(r, cycle_observables(r, observe), {}, {},
+                        run_position_noise(probe->source, position_noise, r));
+  };
+  const SteadyState source = measured(twin.path(probe->source));
+  SteadyState effect = measured(probe->path);
+  for (std::size_t k = 0; k < effect.names.size(); ++k)
+    effect.values[k] -= source[effect.names[k]];
+  effect.drift.clear();
+  return effect;
 }
 
 // The steady-state fit's outputs: the runs' window means (steady_state_runs.csv), the
@@ -1048,12 +1130,16 @@ PlacedReadBack placed_read_back(const Twin& twin, const std::vector<SteadyStateR
   return p;
 }
 
-// The experiment's steady state with a placed packing's read-back as its systematic errors.
-SteadyState with_systematic(SteadyState experiment, const PlacedReadBack& placed) {
+// The experiment's steady state with a placed packing's read-back and its placement probe's
+// effect (where there is one) as its systematic errors, in quadrature.
+SteadyState with_systematic(SteadyState experiment, const PlacedReadBack& placed,
+                            const SteadyState& probe) {
   experiment.systematic.assign(experiment.names.size(), 0.0);
   for (std::size_t k = 0; k < experiment.names.size(); ++k) {
-    const double d = placed.less_experiment[experiment.names[k]];
-    if (std::isfinite(d)) experiment.systematic[k] = std::abs(d);
+    double sum = 0;
+    for (double d : {placed.less_experiment[experiment.names[k]], probe[experiment.names[k]]})
+      if (std::isfinite(d)) sum += d * d;
+    experiment.systematic[k] = std::sqrt(sum);
   }
   return experiment;
 }
@@ -1066,7 +1152,8 @@ struct ScanNoise {
   ContactLocatingError contacts;
   DisplacementError displacements;
   PlacedReadBack placed;
-  SteadyState experiment;  // as fitted: with the read-back as its systematic errors
+  SteadyState probe;       // the placement probe less its source run
+  SteadyState experiment;  // as fitted: with the read-back and the probe as its systematic errors
 };
 
 template <class E>
@@ -1164,8 +1251,9 @@ Fit fit_as_scanned(const Twin& twin, const std::vector<FrictionRunSpec>& specs, 
     fit = fit_to(experiment, runs, only);
   }
   found.placed = placed_read_back(twin, runs, fit.mu_s, fitted_mu_r(fit), given(found.contacts));
-  if (!found.placed.runs.empty()) {
-    experiment = with_systematic(experiment, found.placed);
+  found.probe = placement_probe_effect(twin, given(found.contacts), given(found.displacements));
+  if (!found.placed.runs.empty() || !found.probe.names.empty()) {
+    experiment = with_systematic(experiment, found.placed, found.probe);
     fit = fit_to(experiment, runs, only);
   }
   found.experiment = experiment;
@@ -1303,15 +1391,46 @@ void report_placed_frame(const Twin& twin, const PlacedReadBack& placed, std::os
   j["placed_frame_runs"] = placed.runs.size();
 }
 
+// The placement probe's window less its source's, which the fit carried as the experiment's
+// systematic errors (with the read-back, in quadrature).
+void report_placement_probe(const Twin& twin, const SteadyState& probe, std::ostream& report,
+                            JsonObject& j) {
+  if (probe.names.empty()) return;
+  const PlacementProbe& p = *twin.placement_probe();
+  constexpr double um = 1e6;
+  report << std::setprecision(3) << "  the placement probe (mu_s " << p.source.mu_s << " seed "
+         << p.source.seed << " placed once more from its frame of cycle " << twin.first_cycle()
+         << " moved by the scans' error, " << p.error.x() * um << " um across and "
+         << p.error.z() * um << " along z), less that run:" << std::setprecision(2);
+  JsonObject differences;
+  for (std::size_t k = 0; k < probe.names.size(); ++k) {
+    if (!std::isfinite(probe.values[k])) continue;
+    report << " " << probe.names[k] << " " << std::showpos << probe.values[k] << std::noshowpos;
+    differences[probe.names[k]] = probe.values[k];
+  }
+  report << "; carried as the experiment's systematic errors\n";
+  JsonObject o;
+  o["source"] = twin.path(p.source).filename().string();
+  o["error_um"] = std::vector<double>{p.error.x() * um, p.error.y() * um, p.error.z() * um};
+  o["less_source"] = differences;
+  j["placement_probe"] = o;
+}
+
 // Strictly inside the range of `simulated`.
 bool interior(double mu, const std::vector<double>& simulated) {
   const auto [lo, hi] = std::minmax_element(simulated.begin(), simulated.end());
   return mu > *lo && mu < *hi;
 }
 
-// The design's fit, as the friction (pair) refined packings are added at, and its line.
-std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
-                                                   const std::vector<FrictionRunSpec>& specs) {
+// The design's fit, as the friction (pair) refined packings are added at, its line, and the
+// scans' locating error (m along x, y, z; zero for exact positions): their contacts'
+// reading where they give one, else their standard errors.
+struct DesignFit {
+  FrictionRunSpec at;
+  std::string line;
+  Eigen::Vector3d scan_error = Eigen::Vector3d::Zero();
+};
+DesignFit design_fit(const Twin& twin, const std::vector<FrictionRunSpec>& specs) {
   const CalibrateOptions& o = twin.options();
   std::ostringstream line;
   line << std::setprecision(3) << "the design's fit: ";
@@ -1333,7 +1452,11 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
   for (const NoiseLimited& l : noise.limited)
     if (l.dropped) line << ", without " << l.name << " (the scans' noise)";
   line << "; ";
-  return {at, line.str()};
+  const Eigen::Vector3d stored = twin.errors.position * metres_per_length(twin.experiment());
+  return {at, line.str(),
+          read_from_contacts(noise.contacts) ? position_noise(noise.contacts)
+          : stored.allFinite()               ? stored
+                                             : Eigen::Vector3d::Zero()};
 }
 
 // --refine: the design fitted, then packings more at its fit, each a new seed. Within the
@@ -1341,24 +1464,31 @@ std::pair<FrictionRunSpec, std::string> design_fit(const Twin& twin,
 std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunSpec> specs,
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  auto [at, line] = design_fit(twin, specs);
+  auto [at, line, scan_error] = design_fit(twin, specs);
+  // Placed from scans, one of the packings is the placement probe.
+  const bool probe = twin.placed_from_scans() && !o.joint() && o.refined_packings() >= 2 &&
+                     (scan_error.array() > 0).any();
+  const int packings = o.refined_packings() - (probe ? 1 : 0);
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";
     twin.say(line);
   } else {
-    line += std::to_string(o.refined_packings()) + " packing(s) more at mu_s " +
-            number_text(at.mu_s) + (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") +
-            ", seeds " + std::to_string(twin.next_seed(0)) + "-" +
-            std::to_string(twin.next_seed(o.refined_packings() - 1));
+    line += std::to_string(packings) + " packing(s) more at mu_s " + number_text(at.mu_s) +
+            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") + ", seeds " +
+            std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(packings - 1)) +
+            (probe ? ", and the first placed once more from its own frame moved by the scans' "
+                     "error (the placement probe)"
+                   : "");
     twin.say(line);
     std::vector<std::uint64_t> seeds;
     std::vector<FrictionRunSpec> more;
-    for (int k = 0; k < o.refined_packings(); ++k) {
+    for (int k = 0; k < packings; ++k) {
       seeds.push_back(twin.next_seed(k));
       more.push_back({at.mu_s, seeds.back(), at.mu_r});
     }
     twin.prepare_shared_packings(seeds);
     twin.run(more);
+    if (probe) twin.run_placement_probe(more.front(), scan_error);
     specs.insert(specs.end(), more.begin(), more.end());
   }
   report << line << "\n";
@@ -1383,7 +1513,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   s.mu_s = fit.mu_s;
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
   s.simulations = simulations_with(twin, specs, best);
-  s.simulations_fitted = specs.size();
+  s.simulations_fitted = simulations_fitted(twin, specs);
   const SteadyStateOutputs written =
       write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s, twin.observe.window);
   s.written.insert(s.written.end(), written.written.begin(), written.written.end());
@@ -1420,6 +1550,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   report_contact_error(twin, noise.contacts, left_out, j);
   report_displacement_error(noise.displacements, left_out, j);
   report_placed_frame(twin, noise.placed, left_out, j);
+  report_placement_probe(twin, noise.probe, left_out, j);
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
   report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
@@ -1463,7 +1594,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   s.mu_r_ci95 = {fit.mu_r_ci95[0], fit.mu_r_ci95[1]};
   s.correlation = fit.correlation;
   s.simulations = simulations_with(twin, specs, best);
-  s.simulations_fitted = specs.size();
+  s.simulations_fitted = simulations_fitted(twin, specs);
   std::vector<double> run_s, run_r;
   for (const FrictionRunSpec& r : specs) {
     run_s.push_back(r.mu_s);
@@ -1500,6 +1631,7 @@ void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, Cali
   report_contact_error(twin, noise.contacts, left_out, j);
   report_displacement_error(noise.displacements, left_out, j);
   report_placed_frame(twin, noise.placed, left_out, j);
+  report_placement_probe(twin, noise.probe, left_out, j);
   j["systematic_sigma"] = fit.systematic_sigma;
   add_protocol(j, twin);
   write_json(o.out / "summary.json", j);
@@ -1590,7 +1722,7 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
   s.mu_s = fit.mu_s;
   s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
   s.simulations = simulations_with(twin, specs, best);
-  s.simulations_fitted = specs.size();
+  s.simulations_fitted = simulations_fitted(twin, specs);
   write_displacement_tables(o.out, fit, specs, runs, best, at_fit);
   s.written.push_back(o.out / "cdf_summaries.csv");
   s.written.push_back(o.out / "runs.csv");

@@ -341,7 +341,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
     every run (``None``: 0, but for a steady-state fit of mu_s whose ``mu_s`` and ``replicas``
-    are left to it 3, placed 4). ``axis_noise``
+    are left to it 3, placed 4; placed from scans, the last is the placement probe, the first
+    placed again from its own frame moved by the scans' error). ``axis_noise``
     (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
     the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.
@@ -359,7 +360,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     placed from the experiment's packing 0.05, 0.13, 0.35, 0.6 on 2, then 4 more at their fit), for the
     joint fit 0.05, 0.12, 0.3 on 2 (x each ``mu_r``), for "displacements" 0.03, 0.05, 0.08,
     0.12, 0.2, 0.3, 0.5 on 2. ``degree``: of the trend in ln mu_s through the runs; 0: 3 for
-    mu_s alone on a twin placed from a simulation's exact frame, else 2.
+    mu_s alone on a twin placed from the experiment's packing, else 2.
 
     ``twin``: the twin's simulate settings with ``_`` for ``-``, e.g. ``grains=1500,
     box="5cm", amplitude="1%"`` (as ``simulate``; the experiment's protocol). ``progress``

@@ -97,9 +97,14 @@ Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
 }
 
 Grains jittered(Grains grains, double jitter, std::uint64_t seed, const DepositOptions& deposit) {
+  return jittered(std::move(grains), Eigen::Vector3d::Constant(jitter), seed, deposit);
+}
+
+Grains jittered(Grains grains, const Eigen::Vector3d& jitter, std::uint64_t seed,
+                const DepositOptions& deposit) {
   Random random(seed);
   for (Eigen::Vector3d& x : grains.x)
-    x += jitter * normal_vector(random);
+    x += jitter.cwiseProduct(normal_vector(random));
   keep_in_box(grains, deposit);
   return grains;
 }

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "granmem/core/trajectory_store.hpp"
@@ -456,6 +457,62 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   from_later.insert(from_later.end(), {"--deposit", "experiment", "--placed-cycle", "0"});
   expect_clean_failure(from_later, {"later.h5", "--deposit experiment", "frame of cycle 0",
                                     "(--placed-cycle)", "has none"});
+}
+
+// The "name": value pairs of summary.json's object under `key` (one level, numbers only).
+std::map<std::string, double> json_numbers_under(const std::string& json, const std::string& key) {
+  std::map<std::string, double> values;
+  const auto at = json.find("\"" + key + "\":");
+  if (at == std::string::npos) return values;
+  const auto open = json.find('{', at), close = json.find('}', open);
+  for (auto q = json.find('"', open); q < close; q = json.find('"', json.find(',', q))) {
+    const auto end = json.find('"', q + 1);
+    values[json.substr(q + 1, end - q - 1)] = std::strtod(json.c_str() + end + 2, nullptr);
+    if (json.find(',', q) > close) break;
+  }
+  return values;
+}
+
+// Placed from scans (a fine scan's frame, which carries its locating errors), the first
+// refined packing is placed once more from its own frame moved by the scans' error: the
+// placement probe, one of the refined simulations. What it does to the window is carried as
+// the experiment's systematic error (each observable's at least the probe's), and a second
+// call reuses it; a simulation's exact frame needs no probe.
+TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {
+  Trajectories scans = read_trajectories(in_work("exp.h5"));
+  scans.header.has_position_error = true;
+  for (Frame& f : scans.frames)
+    f.position_error = Eigen::RowVector3d::Constant(0.0006 * 0.005).replicate(f.position.rows(), 1);
+  write_trajectories(in_work("fine.h5"), scans);
+  std::vector<std::string> probed =
+      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only"});
+  probed[2] = "fine.h5";
+  const RunResult r = granmem_ok(probed);
+  EXPECT_NE(r.out.find("1 packing(s) more at mu_s "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("and the first placed once more from its own frame moved by the scans' "
+                       "error (the placement probe)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("seed 3 placed once more from its frame of cycle 1 moved by the scans' "
+                       "error"),
+            std::string::npos)
+      << r.out;
+  const std::string json = read_text(in_work("cal/summary.json"));
+  EXPECT_EQ(json_value(json, "n_simulations"), 6 + 1 + 1) << json;
+  const std::map<std::string, double> probe = json_numbers_under(json, "less_source");
+  ASSERT_FALSE(probe.empty()) << json;
+  for (const auto& [name, effect] : probe) {
+    const auto at = json.find("\"" + name + "\": {");
+    if (at == std::string::npos) continue;  // measured, not fitted
+    const double systematic = json_value(json.substr(at), "experiment_systematic");
+    EXPECT_GE(systematic, std::abs(effect) * (1 - 1e-9)) << name << "\n" << json;
+  }
+  EXPECT_NE(granmem_ok(probed).err.find("reusing the placement probe"), std::string::npos);
+  // From the simulation's exact frame: both refined packings are packings, no probe.
+  const RunResult exact = granmem_ok(
+      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only"}));
+  EXPECT_EQ(exact.out.find("placement probe"), std::string::npos) << exact.out;
+  EXPECT_NE(exact.out.find("2 packing(s) more at mu_s "), std::string::npos) << exact.out;
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {

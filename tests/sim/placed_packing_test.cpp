@@ -160,6 +160,35 @@ TEST_F(PlacedPacking, EachReplicaIsJitteredByItsRmsAndStaysInTheBox) {
   EXPECT_NEAR(std::sqrt(sum / double(n)), jitter, 0.07 * jitter);
 }
 
+// A frame moved by a scan's locating error: each axis by its own RMS (larger along z), and
+// a jitter alike on every axis is the same draws as the scalar one.
+TEST_F(PlacedPacking, AScansErrorMovesEachAxisByItsOwnRms) {
+  const TrajectoryReader run(path("run.h5"));
+  const Grains g = grains_of_frame(run, 0, pour, physics);
+  const Eigen::Vector3d error(5e-5, 5e-5, 1e-4);
+  const Grains moved = jittered(g, error, 3, pour);
+  Eigen::Array3d sum = Eigen::Array3d::Zero();
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const Eigen::Vector3d d = moved.x[i] - g.x[i];
+    const double clear = g.radius[i] + 10 * error.maxCoeff();
+    if (g.x[i].minCoeff() < clear || std::max(g.x[i].x(), g.x[i].y()) > pour.box_side - clear)
+      continue;  // grains against a wall may be kept inside
+    sum += d.array().square();
+    ++n;
+  }
+  ASSERT_GT(n, 100u);
+  // An RMS of n normals is within 3/sqrt(2 n) of its sigma, three standard errors (18 % at
+  // the 144 grains clear of the walls here).
+  const Eigen::Array3d rms = (sum / double(n)).sqrt();
+  for (int a = 0; a < 3; ++a)
+    EXPECT_NEAR(rms[a], error[a], 3 / std::sqrt(2.0 * double(n)) * error[a]) << "axis " << a;
+  const Grains alike = jittered(g, Eigen::Vector3d::Constant(1e-4), 1, pour);
+  const Grains scalar = jittered(g, 1e-4, 1, pour);
+  for (std::size_t i = 0; i < g.size(); ++i)
+    EXPECT_EQ(alike.x[i], scalar.x[i]);
+}
+
 TEST_F(PlacedPacking, APackingAtRestPlacedAgainSettlesWhereItWas) {
   // The deposited packing (frame 0) placed with no contact forces and the lid on it at once:
   // the springs of its contacts build again within microns of slip (a contact's load over

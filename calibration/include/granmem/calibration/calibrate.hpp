@@ -108,12 +108,10 @@ struct CalibrateOptions {
   std::optional<double> axis_noise;
   bool subtract_drift = true;  // the packing's mean displacement, on both sides
   // Of the polynomial in ln mu_s through the runs; 0: 3 where mu_s alone is fitted on a twin
-  // placed from a simulation's exact frame over at least four frictions (over 0.05-0.6 the
-  // observables bend between 0.13 and 0.35, and a quadratic leaves 4-7x the packings' scatter;
-  // docs/CALIBRATION.md, "The placed packing tapped by its own settle"), else 2. Scans keep 2:
-  // with their placed packing's read-back carried the cubic met the bar on 4 of 5 scanned
-  // cases, but the main job's 3-cycle window after placing leaned it 5 % high, its interval
-  // missing the truth ("The placed packing's read-back as a systematic error").
+  // placed from the experiment's packing (a simulation's or scans') over at least four
+  // frictions (over 0.05-0.6 the observables bend between 0.13 and 0.35, and a quadratic
+  // leaves 4-7x the packings' scatter; docs/CALIBRATION.md, "The placed packing tapped by its
+  // own settle" and "The scans' floor at their bottom layer"), else 2.
   int degree = 0;
   // Packings per friction (seeds seed, seed + 1, ...); 0: the observables' own design (so a
   // caller's 0 is not refused, it is the default).
@@ -130,6 +128,10 @@ struct CalibrateOptions {
   // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
   // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
   // packing's scatter where the experiment is, as realizations independent of the design's.
+  // A twin placed from scans (not a simulation's exact frame) makes the last of them its
+  // placement probe instead: the first placed once more from its own frame moved by the
+  // scans' locating error, whose window less that run's is carried as the experiment's
+  // systematic error (what placing from such a frame does, which 0.5 um replicas do not see).
   // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
   std::optional<int> refine;
   int refined_packings() const { return refine.value_or(0); }

@@ -34,4 +34,9 @@ Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
 // frame whose positions are known to about `jitter`.
 Grains jittered(Grains grains, double jitter, std::uint64_t seed, const DepositOptions& deposit);
 
+// The same with a jitter of its own along x, y and z (m): a frame moved by a scan's locating
+// error, larger along z.
+Grains jittered(Grains grains, const Eigen::Vector3d& jitter, std::uint64_t seed,
+                const DepositOptions& deposit);
+
 }  // namespace granmem

@@ -448,7 +448,7 @@ class Twin {
   // The trend's degree (CalibrateOptions::degree; 0: by the twin).
   int trend_degree() const {
     if (o_.degree > 0) return o_.degree;
-    return placed_ && !o_.joint() && o_.mu_s.size() >= 4 ? 3 : 2;
+    return placed_ && !o_.joint() && o_.mu_s.size() >= o_.frictions_for_degree(3) ? 3 : 2;
   }
   const TrajectoryReader& experiment() const { return experiment_; }
   // The seeds after the design's: packings none of its runs pour.
@@ -1400,8 +1400,9 @@ void report_placement_probe(const Twin& twin, const SteadyState& probe, std::ost
   constexpr double um = 1e6;
   report << std::setprecision(3) << "  the placement probe (mu_s " << p.source.mu_s << " seed "
          << p.source.seed << " placed once more from its frame of cycle " << twin.first_cycle()
-         << " moved by the scans' error, " << p.error.x() * um << " um across and "
-         << p.error.z() * um << " along z), less that run:" << std::setprecision(2);
+         << " moved by the scans' error, " << p.error.x() * um << ", " << p.error.y() * um
+         << " and " << p.error.z() * um
+         << " um along x, y and z), less that run:" << std::setprecision(2);
   JsonObject differences;
   for (std::size_t k = 0; k < probe.names.size(); ++k) {
     if (!std::isfinite(probe.values[k])) continue;
@@ -1422,9 +1423,9 @@ bool interior(double mu, const std::vector<double>& simulated) {
   return mu > *lo && mu < *hi;
 }
 
-// The design's fit, as the friction (pair) refined packings are added at, its line, and the
-// scans' locating error (m along x, y, z; zero for exact positions): their contacts'
-// reading where they give one, else their standard errors.
+// The design's fit, as the friction (pair) refined packings are added at, its line, and, for
+// a twin placed from scans, their locating error (m along x, y, z; else zero): their
+// contacts' reading where they give one, else their standard errors.
 struct DesignFit {
   FrictionRunSpec at;
   std::string line;
@@ -1452,11 +1453,10 @@ DesignFit design_fit(const Twin& twin, const std::vector<FrictionRunSpec>& specs
   for (const NoiseLimited& l : noise.limited)
     if (l.dropped) line << ", without " << l.name << " (the scans' noise)";
   line << "; ";
+  if (!twin.placed_from_scans()) return {at, line.str()};
+  if (read_from_contacts(noise.contacts)) return {at, line.str(), position_noise(noise.contacts)};
   const Eigen::Vector3d stored = twin.errors.position * metres_per_length(twin.experiment());
-  return {at, line.str(),
-          read_from_contacts(noise.contacts) ? position_noise(noise.contacts)
-          : stored.allFinite()               ? stored
-                                             : Eigen::Vector3d::Zero()};
+  return {at, line.str(), stored.allFinite() ? stored : Eigen::Vector3d::Zero()};
 }
 
 // --refine: the design fitted, then packings more at its fit, each a new seed. Within the
@@ -1474,8 +1474,10 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
     twin.say(line);
   } else {
     line += std::to_string(packings) + " packing(s) more at mu_s " + number_text(at.mu_s) +
-            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") + ", seeds " +
-            std::to_string(twin.next_seed(0)) + "-" + std::to_string(twin.next_seed(packings - 1)) +
+            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") +
+            (packings > 1 ? ", seeds " + std::to_string(twin.next_seed(0)) + "-" +
+                                std::to_string(twin.next_seed(packings - 1))
+                          : ", seed " + std::to_string(twin.next_seed(0))) +
             (probe ? ", and the first placed once more from its own frame moved by the scans' "
                      "error (the placement probe)"
                    : "");
@@ -1855,9 +1857,8 @@ void CalibrateOptions::validate() const {
         "start from the experiment's first frame)");
   }
   if (degree < 0) throw Error("--degree: at least 1, or 0 (by the twin)");
-  // A joint twin's spare runs come from its grid; one friction's from replicas or one more.
   const int fitted = degree > 0 ? degree : 2;
-  const std::size_t needed = std::size_t(fitted) + (joint() || replicas > 1 ? 1 : 2);
+  const std::size_t needed = frictions_for_degree(fitted);
   if (mu_s.size() < needed) {
     throw Error("--mu-s: " + std::to_string(mu_s.size()) + " frictions; the fit needs at least " +
                 std::to_string(needed) + " (degree " + std::to_string(fitted) + " + 1" +

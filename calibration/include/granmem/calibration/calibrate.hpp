@@ -135,6 +135,11 @@ struct CalibrateOptions {
   // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
   std::optional<int> refine;
   int refined_packings() const { return refine.value_or(0); }
+  // The frictions a trend of `degree` needs: its degree + 1, and one more to measure the
+  // runs' scatter where a friction has one packing (a joint twin's spare runs are its grid's).
+  std::size_t frictions_for_degree(int degree) const {
+    return std::size_t(degree) + (joint() || replicas > 1 ? 1 : 2);
+  }
   // The frictions a pseudo-experiment was made with, for the report and the figures, where
   // its store does not say them (scans drawn from a simulation); a simulation's own are
   // read from its store (given as well, they must agree).

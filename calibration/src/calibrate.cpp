@@ -345,8 +345,6 @@ FrictionFitOptions displacement_fit_options(const CalibrateOptions& o, const Run
   return fit;
 }
 
-// Everything the calibration's stages share: the experiment, the twin's physics and
-// protocol, and how to run the twin (reusing what a stopped call finished).
 // The placed packing's grain count and a digest of its grains' positions.
 std::string placed_identity(const Grains& grains) {
   std::uint64_t digest = kFnv1aBasis;
@@ -364,6 +362,8 @@ struct PlacementProbe {
   Eigen::Vector3d error;  // m, the scans' locating error it was moved by
 };
 
+// Everything the calibration's stages share: the experiment, the twin's physics and
+// protocol, and how to run the twin (reusing what a stopped call finished).
 class Twin {
  public:
   Twin(const CalibrateOptions& options, const TrajectoryReader& experiment)
@@ -872,6 +872,19 @@ PositionNoise run_position_noise(const FrictionRunSpec& spec, const Eigen::Vecto
   return noise;
 }
 
+// The steady state of the twin's run `spec` stored at `path` (its own, or its placement
+// probe's), its positions and displacements given the scans' errors (twin_steady_states).
+SteadyState twin_run_steady_state(const Twin& twin, const fs::path& path,
+                                  const FrictionRunSpec& spec,
+                                  const Eigen::Vector3d& position_noise,
+                                  const Eigen::Vector3d& displacement_noise) {
+  ObservableOptions observe = twin.observe;
+  observe.position_noise = displacement_noise;
+  const TrajectoryReader r(path);
+  return steady_state(r, cycle_observables(r, observe), {}, {},
+                      run_position_noise(spec, position_noise, r));
+}
+
 // The twin's runs' steady states. `position_noise` (m, along x, y and z): the scans'
 // locating error, given to every run's positions before their structure is measured, each
 // run its own draws; `displacement_noise` (m): the per-frame error that moves the scans'
@@ -880,13 +893,10 @@ std::vector<SteadyStateRun> twin_steady_states(
     const Twin& twin, const std::vector<FrictionRunSpec>& specs,
     const Eigen::Vector3d& position_noise = Eigen::Vector3d::Zero(),
     const Eigen::Vector3d& displacement_noise = Eigen::Vector3d::Zero()) {
-  ObservableOptions observe = twin.observe;
-  observe.position_noise = displacement_noise;
   std::vector<SteadyStateRun> runs;
   for (const FrictionRunSpec& spec : specs) {
-    const TrajectoryReader r(twin.path(spec));
-    const SteadyState state = steady_state(r, cycle_observables(r, observe), {}, {},
-                                           run_position_noise(spec, position_noise, r));
+    const SteadyState state =
+        twin_run_steady_state(twin, twin.path(spec), spec, position_noise, displacement_noise);
     runs.push_back({spec.mu_s, spec.seed, state, spec.mu_r});
   }
   return runs;
@@ -898,12 +908,8 @@ SteadyState placement_probe_effect(const Twin& twin, const Eigen::Vector3d& posi
                                    const Eigen::Vector3d& displacement_noise) {
   const std::optional<PlacementProbe>& probe = twin.placement_probe();
   if (!probe) return {};
-  ObservableOptions observe = twin.observe;
-  observe.position_noise = displacement_noise;
   const auto measured = [&](const fs::path& path) {
-    const TrajectoryReader r(path);
-    return steady_state(r, cycle_observables(r, observe), {}, {},
-                        run_position_noise(probe->source, position_noise, r));
+    return twin_run_steady_state(twin, path, probe->source, position_noise, displacement_noise);
   };
   const SteadyState source = measured(twin.path(probe->source));
   SteadyState effect = measured(probe->path);
@@ -1365,6 +1371,20 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
   j["locating_error_from_contacts"] = c;
 }
 
+// A difference of steady states carried as the experiment's systematic errors: each finite
+// one on the report's line, ended there, and returned for summary.json.
+JsonObject reported_as_systematic(const SteadyState& d, std::ostream& report) {
+  JsonObject differences;
+  report << std::setprecision(2);
+  for (std::size_t k = 0; k < d.names.size(); ++k) {
+    if (!std::isfinite(d.values[k])) continue;
+    report << " " << d.names[k] << " " << std::showpos << d.values[k] << std::noshowpos;
+    differences[d.names[k]] = d.values[k];
+  }
+  report << "; carried as the experiment's systematic errors\n";
+  return differences;
+}
+
 // A placed twin's packing read back at the frame it was placed from: the structure of the
 // run nearest the fit there (its positions given the scans' error where their contacts read
 // one) minus the experiment's own. A settle that taps the placed packing denser than its
@@ -1374,20 +1394,12 @@ void report_contact_error(const Twin& twin, const ContactLocatingError& e, std::
 void report_placed_frame(const Twin& twin, const PlacedReadBack& placed, std::ostream& report,
                          JsonObject& j) {
   if (placed.runs.empty()) return;
-  JsonObject differences;
   report << std::setprecision(3) << "  the placed packing read back at its frame of cycle "
          << twin.first_cycle() << " (mu_s " << placed.runs.front().mu_s;
   if (placed.runs.front().mu_r >= 0) report << ", mu_r " << placed.runs.front().mu_r;
   report << ", " << placed.runs.size() << " packing" << (placed.runs.size() > 1 ? "s" : "")
-         << "), less the experiment's:" << std::setprecision(2);
-  const SteadyState& d = placed.less_experiment;
-  for (std::size_t k = 0; k < d.names.size(); ++k) {
-    if (!std::isfinite(d.values[k])) continue;
-    report << " " << d.names[k] << " " << std::showpos << d.values[k] << std::noshowpos;
-    differences[d.names[k]] = d.values[k];
-  }
-  report << "; carried as the experiment's systematic errors\n";
-  j["placed_frame_less_experiment"] = differences;
+         << "), less the experiment's:";
+  j["placed_frame_less_experiment"] = reported_as_systematic(placed.less_experiment, report);
   j["placed_frame_runs"] = placed.runs.size();
 }
 
@@ -1401,19 +1413,11 @@ void report_placement_probe(const Twin& twin, const SteadyState& probe, std::ost
   report << std::setprecision(3) << "  the placement probe (mu_s " << p.source.mu_s << " seed "
          << p.source.seed << " placed once more from its frame of cycle " << twin.first_cycle()
          << " moved by the scans' error, " << p.error.x() * um << ", " << p.error.y() * um
-         << " and " << p.error.z() * um
-         << " um along x, y and z), less that run:" << std::setprecision(2);
-  JsonObject differences;
-  for (std::size_t k = 0; k < probe.names.size(); ++k) {
-    if (!std::isfinite(probe.values[k])) continue;
-    report << " " << probe.names[k] << " " << std::showpos << probe.values[k] << std::noshowpos;
-    differences[probe.names[k]] = probe.values[k];
-  }
-  report << "; carried as the experiment's systematic errors\n";
+         << " and " << p.error.z() * um << " um along x, y and z), less that run:";
   JsonObject o;
   o["source"] = twin.path(p.source).filename().string();
   o["error_um"] = std::vector<double>{p.error.x() * um, p.error.y() * um, p.error.z() * um};
-  o["less_source"] = differences;
+  o["less_source"] = reported_as_systematic(probe, report);
   j["placement_probe"] = o;
 }
 
@@ -1465,9 +1469,8 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   auto [at, line, scan_error] = design_fit(twin, specs);
-  // Placed from scans, one of the packings is the placement probe.
-  const bool probe = twin.placed_from_scans() && !o.joint() && o.refined_packings() >= 2 &&
-                     (scan_error.array() > 0).any();
+  // Placed from scans (their error read), one of the packings is the placement probe.
+  const bool probe = !o.joint() && o.refined_packings() >= 2 && (scan_error.array() > 0).any();
   const int packings = o.refined_packings() - (probe ? 1 : 0);
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";

@@ -84,13 +84,15 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "realization noise the interval includes; default steady-state 3 (placed 2), "
                   "the joint fit and displacements 2")
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--refine", args->refine,
-                  "steady-state: packings added at the fit of the --mu-s (x --mu-r) x "
-                  "--replicas design, each its own seed, and the fit made again on every run "
-                  "(they measure one packing's scatter where the experiment is; placed from scans, "
-                  "the last is the placement probe: the first placed again from its own frame "
-                  "moved by the scans' error); default 0, but 3 for a steady-state fit of mu_s "
-                  "with --mu-s and --replicas left out (placed 4)")
+  cmd->add_option(
+         "--refine", args->refine,
+         "steady-state: packings added about the fit of the --mu-s (x --mu-r) x "
+         "--replicas design, each its own seed (placed: one at fit / 1.15, one at "
+         "fit x 1.15, the rest at it; poured: all at it), and the fit made again on every run "
+         "(they measure one packing's scatter where the experiment is; placed from scans, "
+         "the last is the placement probe: the first placed again from its own frame "
+         "moved by the scans' error); default 0, but 3 for a steady-state fit of mu_s "
+         "with --mu-s and --replicas left out (placed 4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
                   "each: every run pours its seed's grains and deposits them at its own mu_s "

@@ -495,7 +495,8 @@ class Twin {
          << observe.window.first << ":" << observe.window.second << "), mu_s " << mu << ", "
          << o_.replicas << " packing(s) from seed " << deposit_.seed;
     if (o_.refined_packings() > 0)
-      line << ", then " << o_.refined_packings() << " more at their fit";
+      line << ", then " << o_.refined_packings() << " more " << (placed() ? "about" : "at")
+           << " their fit";
     line << ", " << preparation_text();
     if (observe.axis_noise > 0) {
       line << "; the twin's hole axes tilted by " << std::setprecision(3)
@@ -1427,7 +1428,7 @@ bool interior(double mu, const std::vector<double>& simulated) {
   return mu > *lo && mu < *hi;
 }
 
-// The design's fit, as the friction (pair) refined packings are added at, its line, and, for
+// The design's fit, as the friction (pair) refined packings are added about, its line, and, for
 // a twin placed from scans, their locating error (m along x, y, z; else zero): their
 // contacts' reading where they give one, else their standard errors.
 struct DesignFit {
@@ -1463,8 +1464,23 @@ DesignFit design_fit(const Twin& twin, const std::vector<FrictionRunSpec>& specs
   return {at, line.str(), stored.allFinite() ? stored : Eigen::Vector3d::Zero()};
 }
 
-// --refine: the design fitted, then packings more at its fit, each a new seed. Within the
-// design's range only: a fit at its edge says the range is wrong, not where to look.
+// The refined packings' frictions as the report says them: "0.243 x2, 0.322".
+std::string refined_frictions_text(const std::vector<FrictionRunSpec>& more) {
+  std::string text;
+  for (std::size_t k = 0; k < more.size();) {
+    std::size_t same = k;
+    while (same < more.size() && more[same].mu_s == more[k].mu_s)
+      ++same;
+    text += (k ? ", " : "") + number_text(more[k].mu_s) +
+            (same - k > 1 ? " x" + std::to_string(same - k) : "");
+    k = same;
+  }
+  return text;
+}
+
+// --refine: the design fitted, then packings more about its fit (CalibrateOptions::
+// refined_mu_s), each a new seed. Within the design's range only: a fit at its edge says the
+// range is wrong, not where to look.
 std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunSpec> specs,
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
@@ -1475,27 +1491,28 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";
     twin.say(line);
-  } else {
-    line += std::to_string(packings) + " packing(s) more at mu_s " + number_text(at.mu_s) +
-            (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") +
-            (packings > 1 ? ", seeds " + std::to_string(twin.next_seed(0)) + "-" +
-                                std::to_string(twin.next_seed(packings - 1))
-                          : ", seed " + std::to_string(twin.next_seed(0))) +
-            (probe ? ", and the first placed once more from its own frame moved by the scans' "
-                     "error (the placement probe)"
-                   : "");
-    twin.say(line);
-    std::vector<std::uint64_t> seeds;
-    std::vector<FrictionRunSpec> more;
-    for (int k = 0; k < packings; ++k) {
-      seeds.push_back(twin.next_seed(k));
-      more.push_back({at.mu_s, seeds.back(), at.mu_r});
-    }
-    twin.prepare_shared_packings(seeds);
-    twin.run(more);
-    if (probe) twin.run_placement_probe(more.front(), scan_error);
-    specs.insert(specs.end(), more.begin(), more.end());
+    report << line << "\n";
+    return specs;
   }
+  std::vector<std::uint64_t> seeds;
+  std::vector<FrictionRunSpec> more;
+  for (double mu : o.refined_mu_s(at.mu_s, packings)) {
+    seeds.push_back(twin.next_seed(int(more.size())));
+    more.push_back({three_digits(mu), seeds.back(), at.mu_r});
+  }
+  line += std::to_string(packings) + " packing(s) more at mu_s " + refined_frictions_text(more) +
+          (o.joint() ? ", mu_r " + number_text(at.mu_r) : "") +
+          (packings > 1
+               ? ", seeds " + std::to_string(seeds.front()) + "-" + std::to_string(seeds.back())
+               : ", seed " + std::to_string(seeds.front())) +
+          (probe ? ", and the first placed once more from its own frame moved by the scans' "
+                   "error (the placement probe)"
+                 : "");
+  twin.say(line);
+  twin.prepare_shared_packings(seeds);
+  twin.run(more);
+  if (probe) twin.run_placement_probe(more.front(), scan_error);
+  specs.insert(specs.end(), more.begin(), more.end());
   report << line << "\n";
   return specs;
 }
@@ -1794,6 +1811,16 @@ void fit_displacements(const Twin& twin, const std::vector<FrictionRunSpec>& spe
 
 }  // namespace
 
+std::vector<double> CalibrateOptions::refined_mu_s(double fit, int packings) const {
+  std::vector<double> mu(std::size_t(std::max(packings, 0)), fit);
+  if (preparation != TwinPreparation::experiment || packings < 2) return mu;
+  constexpr double kSide = 1.15;
+  const auto [first, last] = std::minmax_element(mu_s.begin(), mu_s.end());
+  mu.front() = std::max(fit / kSide, std::sqrt(fit * *first));
+  mu.back() = std::min(fit * kSide, std::sqrt(fit * *last));
+  return mu;
+}
+
 CalibrateOptions CalibrateOptions::with_default_design() const {
   struct Design {
     std::vector<double> mu_s;
@@ -1802,9 +1829,9 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
   };
   const bool steady = observables == CalibrationObservables::steady_state;
   // A placed twin's replicas differ by their jitter alone and scatter little, so two per
-  // friction measure it; its range reaches past 0.4, and its last four packings go where
-  // the first eight fit. A poured twin's packings scatter more: three per friction, and
-  // three more at their fit.
+  // friction measure it; its range reaches past 0.4, and its last four packings go on both
+  // sides of where the first eight fit. A poured twin's packings scatter more: three per friction,
+  // and three more at their fit.
   const Design design = joint() ? Design{{0.05, 0.12, 0.3}, 2}
                         : steady && preparation == TwinPreparation::experiment
                             ? Design{{0.05, 0.13, 0.35, 0.6}, 2, 4}

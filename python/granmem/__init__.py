@@ -339,7 +339,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     window means of displacement, rotation, packing fraction, coordination, wall force; ``only`` a
     subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
-    at the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design, and the fit made again on
+    about the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design (placed: one at fit /
+    1.15, one at fit x 1.15, the rest at it; poured: all at it), and the fit made again on
     every run (``None``: 0, but for a steady-state fit of mu_s whose ``mu_s`` and ``replicas``
     are left to it 3, placed 4; placed from scans, the last is the placement probe, the first
     placed again from its own frame moved by the scans' error). ``axis_noise``

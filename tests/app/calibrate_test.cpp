@@ -260,7 +260,7 @@ TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
 
 // --refine: the design's fit, then packings of new seeds at it, and the fit again on all
 // runs, their held-out runs at the refined friction counted in the cross-validation.
-TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
+TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAboutItsFit) {
   expect_clean_failure(
       calibrate({"--refine", "2", "--mu-s", "0.05,0.1,0.4", "--observables", "displacements"}),
       {"--refine", "steady-state"});
@@ -277,15 +277,22 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAtItsFit) {
   const std::string design_fit = first.out.substr(first.out.find("mu_s = ") + 7, 5);
   EXPECT_NE(r.out.find("the design's fit: mu_s = " + design_fit), std::string::npos)
       << first.out << r.out;
+  // Placed from the simulation's frame: one a factor 1.15 below the fit, one above (each at
+  // most halfway in ln mu_s to the design's friction beyond it).
   const std::size_t from = r.out.find("packing(s) more at mu_s ") + 24;
-  const std::string at = r.out.substr(from, r.out.find(", seeds", from) - from);
-  EXPECT_NEAR(std::stod(at), std::stod(design_fit), 0.0051);
+  const std::size_t comma = r.out.find(", ", from);
+  const std::string below = r.out.substr(from, comma - from);
+  const std::string above = r.out.substr(comma + 2, r.out.find(", seeds", from) - comma - 2);
+  const double fit = std::stod(design_fit);
+  EXPECT_LT(std::stod(below), fit);
+  EXPECT_GE(std::stod(below), fit / 1.15 - 0.0051);
+  EXPECT_GT(std::stod(above), fit);
+  EXPECT_LE(std::stod(above), fit * 1.15 + 0.0051);
   EXPECT_NE(r.out.find("seeds 3-4"), std::string::npos) << r.out;
   EXPECT_NE(json.find("\"n_simulations\": 8"), std::string::npos) << json;
-  for (const char* seed : {"_seed_3.h5", "_seed_4.h5"}) {
-    const std::string run = "cal/runs/mu_s_" + at + seed;
+  for (const std::string& run :
+       {"cal/runs/mu_s_" + below + "_seed_3.h5", "cal/runs/mu_s_" + above + "_seed_4.h5"})
     EXPECT_TRUE(std::filesystem::exists(in_work(run))) << run;
-  }
   // Both new packings are interior runs of the cross-validation, beside the design's two
   // at 0.1.
   EXPECT_NE(r.out.find("from 4 runs"), std::string::npos) << r.out;

@@ -2,6 +2,8 @@
 // (docs/CALIBRATION.md), and what the caller gives kept.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "granmem/calibration/calibrate.hpp"
@@ -50,6 +52,33 @@ TEST(CalibrateOptions, EachFitGetsTheDesignMeasuredForIt) {
   EXPECT_EQ(placed.with_default_design().refine, 0);
   placed.refine = 2;
   EXPECT_EQ(placed.with_default_design().refine, 2);
+}
+
+TEST(CalibrateOptions, APlacedTwinsRefinedPackingsHoldTheTrendOnBothSidesOfItsFit) {
+  CalibrateOptions placed;
+  placed.preparation = TwinPreparation::experiment;
+  placed = placed.with_default_design();  // 0.05, 0.13, 0.35, 0.6
+  // Four: one a factor 1.15 below the fit, one above, two at it (their scatter there).
+  std::vector<double> mu = placed.refined_mu_s(0.28, 4);
+  ASSERT_EQ(mu.size(), 4u);
+  EXPECT_NEAR(mu[0], 0.28 / 1.15, 1e-12);
+  EXPECT_EQ(mu[1], 0.28);
+  EXPECT_EQ(mu[2], 0.28);
+  EXPECT_NEAR(mu[3], 0.28 * 1.15, 1e-12);
+  // Three (the fourth the placement probe): one on each side and one at the fit.
+  EXPECT_EQ(placed.refined_mu_s(0.28, 3)[1], 0.28);
+  EXPECT_EQ(placed.refined_mu_s(0.28, 1), (std::vector<double>{0.28}));
+  // Near the design's end: no farther than halfway (in ln mu_s) to it, so inside it.
+  mu = placed.refined_mu_s(0.55, 2);
+  EXPECT_NEAR(mu.front(), 0.55 / 1.15, 1e-12);
+  EXPECT_NEAR(mu.back(), std::sqrt(0.55 * 0.6), 1e-12);
+  mu = placed.refined_mu_s(0.055, 2);
+  EXPECT_NEAR(mu.front(), std::sqrt(0.055 * 0.05), 1e-12);
+  // A poured twin's stay at the fit, where they measure its packings' scatter.
+  CalibrateOptions poured;
+  poured.preparation = TwinPreparation::each;
+  poured = poured.with_default_design();
+  EXPECT_EQ(poured.refined_mu_s(0.2, 3), (std::vector<double>(3, 0.2)));
 }
 
 class ResolvedOptions : public testing::TempDirTest {

@@ -125,9 +125,10 @@ struct CalibrateOptions {
   // the experiment's. Unset (auto): the cycle before the window (placed_cycle_for()).
   std::optional<std::int64_t> placed_cycle;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
-  // Steady state: packings added at the design's fit (mu_s, or mu_s and mu_r jointly), each
-  // its own seed (seed + replicas, ...), then the fit made again on every run. They measure one
-  // packing's scatter where the experiment is, as realizations independent of the design's.
+  // Steady state: packings added about the design's fit (mu_s, or mu_s and mu_r jointly; at
+  // refined_mu_s()), each its own seed (seed + replicas, ...), then the fit made again on every
+  // run. They measure one packing's scatter where the experiment is, as realizations
+  // independent of the design's, and hold the trend there.
   // A twin placed from scans (not a simulation's exact frame) makes the last of them its
   // placement probe instead: the first placed once more from its own frame moved by the
   // scans' locating error, whose window less that run's is carried as the experiment's
@@ -135,6 +136,13 @@ struct CalibrateOptions {
   // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
   std::optional<int> refine;
   int refined_packings() const { return refine.value_or(0); }
+  // The mu_s of `packings` refined packings about the design's fit `fit`. A twin placed from
+  // the experiment's packing puts one at fit / 1.15, one at fit x 1.15 (each at most halfway,
+  // in ln mu_s, to the design's end beyond it) and the rest at the fit: its cubic bends across
+  // the design's 0.13-0.35, where the fit wants the trend held on both sides of it, and near
+  // 0.5 it wants the packings' scatter at it (docs/CALIBRATION.md, "The refined packings on
+  // both sides of the fit"). A poured twin's all stay at the fit.
+  std::vector<double> refined_mu_s(double fit, int packings) const;
   // The frictions a trend of `degree` needs: its degree + 1, and one more to measure the
   // runs' scatter where a friction has one packing (a joint twin's spare runs are its grid's).
   std::size_t frictions_for_degree(int degree) const {

@@ -258,8 +258,8 @@ TEST_F(Calibrate, TakesTheLocatingNoiseFromTheScansStandardErrors) {
                        {"--noise scans", "no position standard errors"});
 }
 
-// --refine: the design's fit, then packings of new seeds at it, and the fit again on all
-// runs, their held-out runs at the refined friction counted in the cross-validation.
+// --refine: the design's fit, then packings of new seeds about it, and the fit again on all
+// runs, their held-out runs at the refined frictions counted in the cross-validation.
 TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAboutItsFit) {
   expect_clean_failure(
       calibrate({"--refine", "2", "--mu-s", "0.05,0.1,0.4", "--observables", "displacements"}),
@@ -278,7 +278,7 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAboutItsFit) {
   EXPECT_NE(r.out.find("the design's fit: mu_s = " + design_fit), std::string::npos)
       << first.out << r.out;
   // Placed from the simulation's frame: one a factor 1.15 below the fit, one above (each at
-  // most halfway in ln mu_s to the design's friction beyond it).
+  // most halfway in ln mu_s to the design's end beyond it).
   const std::size_t from = r.out.find("packing(s) more at mu_s ") + 24;
   const std::size_t comma = r.out.find(", ", from);
   const std::string below = r.out.substr(from, comma - from);

@@ -66,7 +66,10 @@ TEST(CalibrateOptions, APlacedTwinsRefinedPackingsHoldTheTrendOnBothSidesOfItsFi
   EXPECT_EQ(mu[2], 0.28);
   EXPECT_NEAR(mu[3], 0.28 * 1.15, 1e-12);
   // Three (the fourth the placement probe): one on each side and one at the fit.
-  EXPECT_EQ(placed.refined_mu_s(0.28, 3)[1], 0.28);
+  const std::vector<double> three = placed.refined_mu_s(0.28, 3);
+  EXPECT_NEAR(three[0], 0.28 / 1.15, 1e-12);
+  EXPECT_EQ(three[1], 0.28);
+  EXPECT_NEAR(three[2], 0.28 * 1.15, 1e-12);
   EXPECT_EQ(placed.refined_mu_s(0.28, 1), (std::vector<double>{0.28}));
   // Near the design's end: no farther than halfway (in ln mu_s) to it, so inside it.
   mu = placed.refined_mu_s(0.55, 2);

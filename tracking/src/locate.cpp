@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 
+#include "exact_radius.hpp"
 #include "granmem/core/cell_grid.hpp"
 #include "granmem/core/error.hpp"
 #include "granmem/core/statistics.hpp"
@@ -234,7 +235,9 @@ class GrainLocator {
   // sample of the grains is refitted with them so, for the scan's blur (the medians of the
   // refits') and the model fits' radius shortfall (the median of refit - model fit
   // radius), and then every grain with its neighbours seen through that blur, their radius
-  // so corrected.
+  // so corrected; last, a sample's whole windows give the radius the exactly blurred image
+  // has for a model fit's (exact_radius.hpp), the radius every grain is drawn and reported
+  // with from then on.
   void refit_axes() {
     if (hole_ == 0 || !o_.fit_axis) return;
     const Neighbours known = neighbours(true);
@@ -245,10 +248,10 @@ class GrainLocator {
     refit_axes(known, stride, blur, axis_options, refits);
     if (sample_blur(known.ids, refits, stride, &blur, &axis_options)) {
       refit_axes(known, 1, blur, axis_options, refits);
-      // 24 grains: a scan's systematic, whose grain-to-grain scatter is a few hundredths of
-      // a voxel; whole windows are ~8x the inner ones.
+      // 24 grains: a line's two parameters, through exact radii that scatter by 3 um;
+      // whole windows are ~8x the inner ones.
       const std::size_t every = std::max<std::size_t>(1, known.ids.size() / 24);
-      blur.shortfall = radius_shortfall(known, every, blur, axis_options);
+      blur.radius = exact_radius(known, every, blur, axis_options);
       blur_ = blur;
     }
     for (std::size_t k = 0; k < known.ids.size(); ++k) {
@@ -280,7 +283,7 @@ class GrainLocator {
         near.clear();
         known.grid.near(s.centre, 2, [&](std::size_t j) {
           HoledSphere other = grains_[known.ids[j]].fit.sphere;
-          other.radius += blur_.shortfall;
+          other.radius = blur_.radius(other.radius);
           if (j != k &&
               (other.centre - s.centre).norm() < reach.maxCoeff() + other.radius + 5 * wide)
             near.push_back(other);
@@ -306,8 +309,8 @@ class GrainLocator {
       if (!shaped_like_a_grain(r) ||
           (r.sphere.centre - f.sphere.centre).norm() > 0.5 * vs_.minCoeff())
         continue;
-      // The centre only: the radius, whose shortfall the refits measured on these fits, and
-      // the refit's axis stand.
+      // The centre only: the radius, which the exact refits' line predicts from these fits,
+      // and the refit's axis stand.
       f.sphere.centre = r.sphere.centre;
       f.centre_sigma = r.centre_sigma;
     }
@@ -328,10 +331,10 @@ class GrainLocator {
       if (!g.active) continue;
       const GrainFit& f = g.fit;
       const Eigen::Vector3d voxel = f.sphere.centre.cwiseQuotient(vs_);
-      // The model fit's radius runs small (the blur's curvature shift, 0.3 voxel at 12
-      // voxels), by what the refits on the exactly blurred image measure (with a hole);
+      // The model fit's radius runs small (the blur's curvature shift, 0.35 voxel at 12
+      // voxels): the exactly blurred image's (with a hole), as the refits' line predicts it;
       // for the edge flags, not below the nominal either.
-      const double radius = f.sphere.radius + blur_.shortfall;
+      const double radius = blur_.radius(f.sphere.radius);
       const double outer = std::max(radius, radius_);
       const Eigen::Vector3d r_voxels = Eigen::Vector3d::Constant(outer).cwiseQuotient(vs_);
       const bool edge = ((voxel - r_voxels).array() < -0.5).any() ||
@@ -370,9 +373,12 @@ class GrainLocator {
     std::vector<std::size_t> ids;
     CellGrid grid;
   };
-  // The scan's blur and the model fits' radius shortfall, from a sample of axis refits.
+  // The scan's blur, from a sample of axis refits, and the radius a grain is drawn at for
+  // its model fit's: the model fit's (without refits), plus the sample's median shortfall
+  // (the inner refits), then the whole windows' exact radius (exact_radius()).
   struct AxisBlur {
-    double across = 0, along_z = 0, shortfall = 0;
+    double across = 0, along_z = 0;
+    ExactRadius radius;
     bool sampled = false;
   };
 
@@ -556,12 +562,12 @@ class GrainLocator {
         const GrainFit& f = grains_[ids[k]].fit;
         // Within the refit's radius (the model fit's runs small): ~1 voxel more of the
         // hole at PSF 1.0 / 1.0 / 1.5 voxel (p95 2.96 -> 2.80 deg at d = 12).
-        const double reach = axis_options.within * (f.sphere.radius + blur.shortfall);
+        const double reach = axis_options.within * blur.radius(f.sphere.radius);
         const double wide = std::max(blur.across, blur.along_z);
         near.clear();
         known.grid.near(f.sphere.centre, rings, [&](std::size_t j) {
           HoledSphere s = grains_[ids[j]].start;
-          s.radius += blur.shortfall;
+          s.radius = blur.radius(s.radius);
           const double reach_j = s.radius + 5 * (blur.sampled ? wide : s.widest_blur());
           if (j != k && (s.centre - f.sphere.centre).norm() < reach + reach_j) near.push_back(s);
         });
@@ -582,23 +588,31 @@ class GrainLocator {
     }
   }
 
-  // How much the model fits' radius runs small: the median over the sample of the radius
-  // refitted on the exactly blurred image in the whole window (the rim and three blurs
-  // beyond it; the axis refits' inner voxels see the radius only through the hole, whose
-  // partial volumes bias it on sharp scans) less the model fit's.
-  double radius_shortfall(const Neighbours& known, std::size_t stride, const AxisBlur& blur,
-                          HoleAxisOptions whole) const {
+  // The exactly blurred image's radius for a model fit's: the line through the sample's
+  // radii refitted on it in the whole window (the rim and three blurs beyond it; the axis
+  // refits' inner voxels see the radius only through the hole, whose partial volumes bias
+  // it on sharp scans) against their model fits'.
+  ExactRadius exact_radius(const Neighbours& known, std::size_t stride, const AxisBlur& blur,
+                           HoleAxisOptions whole) const {
     const double wide = std::max(blur.across, blur.along_z);
     whole.within = 1 + (3 * wide + 0.5 * vs_.maxCoeff()) / radius_;
     const double reach = whole.within * radius_ + radius_ + 5 * wide;
     std::vector<HoleAxisFit> refits(known.ids.size());
-    refit_axes(known, stride, blur, whole, refits, int(std::ceil(reach / diameter_)));
-    std::vector<double> shortfall;
-    for (std::size_t k = 0; k < known.ids.size(); k += stride) {
-      if (refits[k].converged)
-        shortfall.push_back(refits[k].radius - grains_[known.ids[k]].fit.sphere.radius);
+    // Twice: the second time the sample's neighbours are drawn at the first line's radius
+    // instead of the inner refits' shortfall (the line's own then, +1.3 um at 12 voxels).
+    AxisBlur seen = blur;
+    for (int pass = 0; pass < 2; ++pass) {
+      refit_axes(known, stride, seen, whole, refits, int(std::ceil(reach / diameter_)));
+      std::vector<double> model, exact;
+      for (std::size_t k = 0; k < known.ids.size(); k += stride) {
+        if (!refits[k].converged) continue;
+        model.push_back(grains_[known.ids[k]].fit.sphere.radius);
+        exact.push_back(refits[k].radius);
+      }
+      if (exact.empty()) break;
+      seen.radius = fit_exact_radius(model, exact);
     }
-    return shortfall.empty() ? 0 : quantile_in_place(shortfall, 0.5);
+    return seen.radius;
   }
 
   // The scan's blur and the radius shortfall, the medians of the sample's converged
@@ -620,9 +634,10 @@ class GrainLocator {
     const auto median = [](std::vector<double>& v) { return quantile_in_place(v, 0.5); };
     blur->across = median(a);
     blur->along_z = median(z);
-    blur->shortfall = median(r);
+    blur->radius = {median(r), 1};
     blur->sampled = true;
-    axis_options->start = {blur->across, blur->along_z, blur->shortfall, median(b), median(g)};
+    axis_options->start = {blur->across, blur->along_z, blur->radius.intercept, median(b),
+                           median(g)};
     return true;
   }
 
@@ -630,8 +645,8 @@ class GrainLocator {
   const LocateOptions& o_;
   const Eigen::Vector3d vs_;
   const double diameter_, radius_, hole_;
-  // The scan's blur and how much the model fits' radius runs small (radius_shortfall()),
-  // as refit_axes() sampled them; not sampled (shortfall 0) without refits.
+  // The scan's blur and the exact radius of a model fit's (exact_radius()), as refit_axes()
+  // sampled them; not sampled (the model fit's radius) without refits.
   AxisBlur blur_;
   CandidateOptions candidate_options_;
   std::vector<Candidate> grains_;
@@ -687,7 +702,12 @@ Detections locate(Stack stack, const LocateOptions& o, LocateSummary* summary) {
   locator.fit();
   begin_stage(o, "hole axes");
   locator.refit_axes();
-  locator.refit_centres();
+  // Twice: the first refit sees each neighbour where the model fits left it, pulled
+  // towards its own neighbours (their product reads shared rims too bright), and pushes the
+  // grain away from it; the second sees the first's centres (docs/BENCHMARKS.md, "The
+  // neighbours at the exact refits' radius, and where the first refit left them").
+  for (int pass = 0; pass < 2; ++pass)
+    locator.refit_centres();
   sum.seconds_fits = lap();
   Detections d = locator.detections(sum);
   sum.seconds = sum.seconds_illumination + sum.seconds_candidates + sum.seconds_fits + lap();

@@ -276,6 +276,31 @@ TEST(Locate, TouchingNeighboursAreReadNeitherCloserNorFarther) {
   EXPECT_LT(near.offset, 0.004);
 }
 
+TEST(Locate, GrainsWithTheirHoleAlongTheSlicesAreNotLockedToThem) {
+  // Every hole within 3 deg of the slices' plane: its wall runs along the slices, 1.2
+  // slices from the axis, under a blur along z of about a slice, where the model's plane
+  // profile of the wall is not the image's. Fitted with it, the centres locked to the
+  // slices: the error along z a sine of the centre's place between two slices, of amplitude
+  // 0.05 slice (30 um on the default render of 5 mm grains; docs/BENCHMARKS.md, "Centres
+  // locked to the slices by a hole along them").
+  PackingScan scan = packing_scan(220, kPhi, 12, 1.5, 41);
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> turn(0, 2 * 3.14159265358979323846), tilt(-0.05, 0.05);
+  for (RenderedGrain& g : scan.grains) {
+    const double phi = turn(rng);
+    g.axis = Eigen::Vector3d(std::cos(phi), std::sin(phi), tilt(rng)).normalized();
+  }
+  Table truth;
+  Stack stack = render_scan(scan.grains, scan.options, &truth);
+  LocateOptions o;
+  o.diameter = 12;
+  const LocateScore s = score_locate(locate(stack, o), truth, *scan.options.voxel_size);
+  report("holes along the slices", s);
+  EXPECT_GT(s.interior_found, 80u);
+  EXPECT_LT(s.locking.z(), 0.015);  // first harmonic of the error vs the place between slices
+  EXPECT_LT(s.rms.z(), 0.03);       // slices
+}
+
 TEST(Locate, AxesUnderABlurWiderThanTheHoleAlongZ) {
   // PSF 1.0 / 1.0 / 1.5 voxel on slices 1.5x coarser: the blur along z, 2.25 voxels of x,
   // is wider than the hole's radius (1.8). The model fits' radius runs ~1 voxel small

@@ -96,6 +96,28 @@ void leave_out_hidden(const std::vector<double>& clear, bool with_clear, GrainWi
   window.intensity.resize(kept);
 }
 
+// Where a grain's hole runs along the slices (its axis within 11.5 deg of their plane), the
+// model's profile of the hole's wall (a blurred plane's, HoledSphere) is not the image's:
+// the wall, ~1.2 slices from the axis under a blur along z of about a slice, is a blurred
+// cylinder's section sampled at the slices' spacing, and the product model fitted to it
+// locks the centre to the slices (a sine of its place between two, 0.04-0.05 slice: 30 um
+// on 5 mm grains; docs/BENCHMARKS.md, "Centres locked to the slices by a hole along
+// them"). There the last centre refit leaves the hole and its wall (within the hole's
+// radius plus 0.75 of the blur along z of the axis, inside the grain) out of its window
+// (`clear` 0), and reads the centre off the grain's outer surface.
+void leave_out_hole_wall_along_slices(const HoledSphere& grain, double hole, double blur_along_z,
+                                      const GrainWindow& window, std::vector<double>& clear) {
+  constexpr double kAlongSlices = 0.2, kWallBand = 0.75;  // |axis z|; of the blur along z
+  const Eigen::Vector3d a = grain.axis.normalized();
+  if (hole <= 0 || !(std::abs(a.z()) < kAlongSlices)) return;
+  const double wall = hole * grain.radius + kWallBand * blur_along_z;
+  const double inside = grain.radius + blur_along_z;
+  for (std::size_t k = 0; k < window.points.size(); ++k) {
+    const Eigen::Vector3d d = window.points[k] - grain.centre;
+    if ((d - d.dot(a) * a).norm() < wall && d.norm() < inside) clear[k] = 0;
+  }
+}
+
 // `grain`'s fraction M at each voxel of `window` within `reach` of its centre, passed on
 // as combine(voxel, M), lanes of voxels at a time.
 template <class Combine>
@@ -295,6 +317,7 @@ class GrainLocator {
                                      blur_.along_z, sum);
         for (double& c : sum)
           c = 1 - c;
+        leave_out_hole_wall_along_slices(s, hole_, blur_.along_z, window, sum);
         leave_out_hidden(sum, true, window);
         window.additive = true;
         if (window.points.size() <= 20) continue;

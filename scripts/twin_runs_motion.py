@@ -29,14 +29,25 @@ def inside(p, margin):
     return np.all((p > lo) & (p < hi), axis=1)
 
 
+def cycle_dr(pos, step, d, c):
+    """Cycle c's mean end-of-cycle |dr| / d, drift removed, grains 1 d inside the extent."""
+    a, b = pos[step.index(c - 1)], pos[step.index(c)]
+    ok = inside(a, d) & np.all(np.isfinite(b), axis=1)
+    u = (b[ok] - a[ok]) / d
+    return np.linalg.norm(u - u.mean(0), axis=1).mean()
+
+
+def dr_per_cycle(path, first, last):
+    pos, step, d = frames(path)
+    return np.array([cycle_dr(pos, step, d, c) for c in range(first, last + 1)])
+
+
 def motion(path, first, last):
     pos, step, d = frames(path)
     dr, yx, zh = [], [], []
     for c in range(first, last + 1):
-        a, b = pos[step.index(c - 1)], pos[step.index(c)]
-        ok = inside(a, d) & np.all(np.isfinite(b), axis=1)
-        u = (b[ok] - a[ok]) / d
-        dr.append(np.linalg.norm(u - u.mean(0), axis=1).mean())
+        dr.append(cycle_dr(pos, step, d, c))
+        b = pos[step.index(c)]
         p = b[np.all(np.isfinite(b), axis=1)]
         pairs = np.array(sorted(cKDTree(p).query_pairs(1.02 * d)))
         bulk = inside(p, 2 * d)
@@ -49,17 +60,22 @@ def motion(path, first, last):
     return np.mean(dr), np.mean(yx), np.mean(zh)
 
 
-first, last = map(int, sys.argv[2].split(":"))
-runs = {}
-for path in glob.glob(sys.argv[1] + "/mu_s_*_seed_*.h5"):
-    mu = float(re.search(r"mu_s_([0-9.]+)_seed_", path).group(1))
-    runs.setdefault(mu, []).append(motion(path, first, last))
-print("mu_s,packings,dr,dr_sd,fabric_yy_xx,fabric_yy_xx_sd,fabric_zz_h,fabric_zz_h_sd")
-for mu in sorted(runs):
-    v = np.array(runs[mu])
-    sd = v.std(0, ddof=1) if len(v) > 1 else np.full(3, np.nan)
-    print(f"{mu},{len(v)},{v[:, 0].mean():.5f},{sd[0]:.5f},{v[:, 1].mean():+.4f},{sd[1]:.4f},"
-          f"{v[:, 2].mean():+.4f},{sd[2]:.4f}")
-if len(sys.argv) > 3:
-    e = motion(sys.argv[3], first, last)
-    print(f"experiment,1,{e[0]:.5f},,{e[1]:+.4f},,{e[2]:+.4f},")
+def main():
+    first, last = map(int, sys.argv[2].split(":"))
+    runs = {}
+    for path in glob.glob(sys.argv[1] + "/mu_s_*_seed_*.h5"):
+        mu = float(re.search(r"mu_s_([0-9.]+)_seed_", path).group(1))
+        runs.setdefault(mu, []).append(motion(path, first, last))
+    print("mu_s,packings,dr,dr_sd,fabric_yy_xx,fabric_yy_xx_sd,fabric_zz_h,fabric_zz_h_sd")
+    for mu in sorted(runs):
+        v = np.array(runs[mu])
+        sd = v.std(0, ddof=1) if len(v) > 1 else np.full(3, np.nan)
+        print(f"{mu},{len(v)},{v[:, 0].mean():.5f},{sd[0]:.5f},{v[:, 1].mean():+.4f},{sd[1]:.4f},"
+              f"{v[:, 2].mean():+.4f},{sd[2]:.4f}")
+    if len(sys.argv) > 3:
+        e = motion(sys.argv[3], first, last)
+        print(f"experiment,1,{e[0]:.5f},,{e[1]:+.4f},,{e[2]:+.4f},")
+
+
+if __name__ == "__main__":
+    main()

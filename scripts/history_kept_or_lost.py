@@ -18,8 +18,7 @@ import granmem
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from scipy.spatial import cKDTree  # noqa: E402
-from twin_runs_motion import dr_per_cycle, frames, inside  # noqa: E402
+from twin_runs_motion import cycle_dr, frames, inside, touching_pairs  # noqa: E402
 
 
 def bulk_packing_fraction(path, first, last):
@@ -27,13 +26,10 @@ def bulk_packing_fraction(path, first, last):
     return f.loc[first:last].to_numpy()
 
 
-def touching(path, cycles):
-    pos, step, d = frames(path)
+def touching(pos, step, d, cycles):
     out = []
     for c in cycles:
-        p = pos[step.index(c)]
-        p = p[np.all(np.isfinite(p), axis=1)]
-        pairs = cKDTree(p).query_pairs(d, output_type="ndarray")
+        p, pairs = touching_pairs(pos[step.index(c)], d)
         out.append(np.bincount(pairs.ravel(), minlength=len(p))[inside(p, 2 * d)].mean())
     return out
 
@@ -54,9 +50,10 @@ print("kind,packing,dr_" + ",dr_".join(str(c) for c in range(first, last + 1)) +
 table = {}
 for kind, paths in runs.items():
     for k, (path, start) in enumerate(paths):
-        dr = dr_per_cycle(path, start, start + n - 1) * 1e4
+        pos, step, d = frames(path)
+        dr = np.array([cycle_dr(pos, step, d, c) for c in range(start, start + n)]) * 1e4
         pf = (bulk_packing_fraction(path, start, start + n - 1).mean() - truth_pf) * 1e4
-        z = touching(path, (start - 1, start + n - 1))
+        z = touching(pos, step, d, (start - 1, start + n - 1))
         table.setdefault(kind, []).append((dr.mean(), pf, *z))
         print(f"{kind},{k + 1}," + ",".join(f"{x:.2f}" for x in dr) +
               f",{dr.mean():.2f},{pf:+.2f},{z[0]:.3f},{z[1]:.3f}")

@@ -11,15 +11,13 @@ import os
 import sys
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from twin_runs_motion import frames, inside  # noqa: E402
+from twin_runs_motion import frames, inside, touching_pairs  # noqa: E402
 
 
 def overlap_stats(p, d):
-    p = p[np.all(np.isfinite(p), axis=1)]
-    pairs = cKDTree(p).query_pairs(d, output_type="ndarray")
+    p, pairs = touching_pairs(p, d)
     bulk = inside(p, 2 * d)
     pairs = pairs[bulk[pairs[:, 0]] & bulk[pairs[:, 1]]]
     overlap = (d - np.linalg.norm(p[pairs[:, 0]] - p[pairs[:, 1]], axis=1)) * 1e6

@@ -29,6 +29,12 @@ def inside(p, margin):
     return np.all((p > lo) & (p < hi), axis=1)
 
 
+def touching_pairs(p, d):
+    """The finite centres of a frame and their pairs closer than `d` (index pairs)."""
+    p = p[np.all(np.isfinite(p), axis=1)]
+    return p, cKDTree(p).query_pairs(d, output_type="ndarray")
+
+
 def cycle_dr(pos, step, d, c):
     """Cycle c's mean end-of-cycle |dr| / d, drift removed, grains 1 d inside the extent."""
     a, b = pos[step.index(c - 1)], pos[step.index(c)]
@@ -37,19 +43,12 @@ def cycle_dr(pos, step, d, c):
     return np.linalg.norm(u - u.mean(0), axis=1).mean()
 
 
-def dr_per_cycle(path, first, last):
-    pos, step, d = frames(path)
-    return np.array([cycle_dr(pos, step, d, c) for c in range(first, last + 1)])
-
-
 def motion(path, first, last):
     pos, step, d = frames(path)
     dr, yx, zh = [], [], []
     for c in range(first, last + 1):
         dr.append(cycle_dr(pos, step, d, c))
-        b = pos[step.index(c)]
-        p = b[np.all(np.isfinite(b), axis=1)]
-        pairs = np.array(sorted(cKDTree(p).query_pairs(1.02 * d)))
+        p, pairs = touching_pairs(pos[step.index(c)], 1.02 * d)
         bulk = inside(p, 2 * d)
         pairs = pairs[bulk[pairs[:, 0]] | bulk[pairs[:, 1]]]
         n = p[pairs[:, 1]] - p[pairs[:, 0]]

@@ -89,9 +89,10 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
          "steady-state: packings added about the fit of the --mu-s (x --mu-r) x "
          "--replicas design, each its own seed (placed: one at fit / 1.15, one at "
          "fit x 1.15, the rest at it; poured: all at it), and the fit made again on every run "
-         "(they measure one packing's scatter where the experiment is; placed from scans, "
-         "the last is the placement probe: the first placed again from its own frame "
-         "moved by the scans' error); default 0, but 3 for a steady-state fit of mu_s "
+         "(they measure one packing's scatter where the experiment is; placed from scans "
+         "after the drive began, the last is the placement probe: the first placed again "
+         "from its own frame moved by the scans' error); default 0, but 3 for a steady-state fit "
+         "of mu_s "
          "with --mu-s and --replicas left out (placed 4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,
@@ -113,10 +114,12 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "normal draw of this RMS a coordinate (a length); auto: 1e-4 grain "
                   "diameters")
       ->capture_default_str();
-  cmd->add_option("--placed-cycle", args->placed_cycle,
-                  "--deposit experiment: the experiment's cycle whose frame the twin's packings "
-                  "are placed from, its runs driven from the next cycle on (0: the packing "
-                  "before the first cycle); auto: the cycle before the window")
+  cmd->add_option(
+         "--placed-cycle", args->placed_cycle,
+         "--deposit experiment: the experiment's cycle whose frame the twin's packings "
+         "are placed from, its runs driven from the next cycle on (0: the packing "
+         "before the first cycle); auto: for scans their first frame (the preparation) where "
+         "it holds the packing, else the cycle before the window")
       ->capture_default_str();
   cmd->add_option("--summaries", args->summaries,
                   "pooled: the CDF of the window's pooled displacements (the paper's steady "

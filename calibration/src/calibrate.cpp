@@ -185,8 +185,16 @@ std::pair<std::int64_t, std::int64_t> compared_window(const CalibrateOptions& op
 
 std::int64_t placed_cycle_for(const CalibrateOptions& options, const TrajectoryReader& experiment) {
   if (options.placed_cycle) return *options.placed_cycle;
-  if (options.auto_window) return experiment.steps().empty() ? 0 : experiment.steps().front();
-  return compared_window(options, experiment).first - 1;
+  const auto& steps = experiment.steps();
+  if (options.auto_window || steps.empty()) return steps.empty() ? 0 : steps.front();
+  const std::int64_t before_window = compared_window(options, experiment).first - 1;
+  // Scans from their first frame, the preparation: centres off by more than a contact's
+  // overlap, settled into a packing the drive has trained, undo its training and the twin
+  // compacts faster through the window; a prepared packing has no training to undo.
+  const bool scans = experiment.header().has_position_error;
+  if (scans && steps.front() < before_window && placeable_packing_at(experiment, steps.front()))
+    return steps.front();
+  return before_window;
 }
 
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
@@ -509,9 +517,16 @@ class Twin {
       say("note: the experiment's frame of cycle " + std::to_string(placed_cycle_) +
           " does not hold its packing exactly (a scan's centres carry their locating errors, "
           "and grains it missed are taken from later frames): the twin's packings settle from "
-          "them; at a scan's usual errors (7 um across, 15 um along z) that moved a fit by "
-          "less than 0.01, but centres off by 20 um settle denser (+0.0016 in packing "
-          "fraction on 2,500 grains) and lean the fit to higher friction");
+          "them; " +
+          (placed_cycle_ > 0
+               ? std::string("settled into a packing the drive has trained, centres off by "
+                             "more than a contact's overlap undo its training: the twin "
+                             "compacts faster, and they lean the fit to higher friction (the "
+                             "placement probe measures it; the scans' first frame, the "
+                             "preparation, has no training to undo)")
+               : std::string("placed from the preparation, before the drive, they leave no "
+                             "training undone, but centres off by 20 um settle denser and "
+                             "lean the fit to higher friction")));
     }
     // Axes from scans without their errors (another program's tracks): the twin's stay
     // exact, and its rotations read small against the scans'; said, not guessed.
@@ -1485,8 +1500,10 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
                                             std::ostream& report) {
   const CalibrateOptions& o = twin.options();
   auto [at, line, scan_error] = design_fit(twin, specs);
-  // Placed from scans (their error read), one of the packings is the placement probe.
-  const bool probe = !o.joint() && o.refined_packings() >= 2 && (scan_error.array() > 0).any();
+  // Placed from scans (their error read) after the drive has begun, one of the packings is the
+  // placement probe; placed from the preparation there is no training for the error to undo.
+  const bool probe = !o.joint() && o.refined_packings() >= 2 && twin.first_cycle() > 0 &&
+                     (scan_error.array() > 0).any();
   const int packings = o.refined_packings() - (probe ? 1 : 0);
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";

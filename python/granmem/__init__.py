@@ -342,7 +342,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     about the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design (placed: one at fit /
     1.15, one at fit x 1.15, the rest at it; poured: all at it), and the fit made again on
     every run (``None``: 0, but for a steady-state fit of mu_s whose ``mu_s`` and ``replicas``
-    are left to it 3, placed 4; placed from scans, the last is the placement probe, the first
+    are left to it 3, placed 4; placed from scans after the drive began, the last is the placement probe, the first
     placed again from its own frame moved by the scans' error). ``axis_noise``
     (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
     the twin's exact axes before their rotations are measured;
@@ -351,7 +351,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     ("auto" too where the store has them, else fits it on scans). ``deposit``: "each" (every
     run pours its own packing at its friction), "shared" (one per seed, its friction
     switched) or "experiment" (every run starts from the grains of the experiment's frame of
-    cycle ``placed_cycle``, "auto": the one before the window, and drives the cycles after it;
+    cycle ``placed_cycle``, "auto": the one before the window, for scans their first frame
+    where it holds the packing, and drives the cycles after it;
     each replica moved by ``placed_jitter``, a length; "auto": 1e-4 grain diameters) or "auto"
     (the default: "experiment" for a steady-state fit of mu_s on a simulation's packing,
     whose frame there holds it exactly, else "each").

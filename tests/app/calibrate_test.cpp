@@ -433,24 +433,36 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   expect_clean_failure(scans_from, {"--placed-cycle 1", "this one is poured"});
   from_scans.insert(from_scans.end(), {"--deposit", "experiment"});
   EXPECT_NE(granmem_ok(from_scans).err.find("lean the fit to higher friction"), std::string::npos);
-  // A fine scan (standard errors 0.0006 d) that locates every grain is placed by default,
-  // the same packing as the simulation's (its runs reused); one that misses 2 of the 60
-  // grains before the window is poured.
+  // A fine scan (standard errors 0.0006 d) that locates every grain is placed by default from
+  // its first frame, the preparation (its centres' errors would undo a drive's training);
+  // placed before the window as asked, it is the same packing as the simulation's (its runs
+  // reused). One that misses 2 of the 60 grains at its preparation is placed before the
+  // window; missing them there too, poured.
   for (Frame& f : scans.frames)
     f.position_error.setConstant(0.0006 * d);
   write_trajectories(in_work("fine.h5"), scans);
   std::vector<std::string> fine = calibrate(design);
   fine[2] = "fine.h5";
+  fine[4] = "fine";
   const RunResult placed_fine = granmem_ok(fine);
-  EXPECT_NE(placed_fine.err.find("placed where the experiment's frame of cycle 1 has its 60"),
+  EXPECT_NE(placed_fine.err.find("placed where the experiment's frame of cycle 0 has its 60"),
             std::string::npos)
       << placed_fine.err;
-  EXPECT_NE(placed_fine.err.find("reusing 6 finished runs"), std::string::npos) << placed_fine.err;
+  std::vector<std::string> fine_before = calibrate(design);
+  fine_before[2] = "fine.h5";
+  fine_before.insert(fine_before.end(), {"--placed-cycle", "1"});
+  EXPECT_NE(granmem_ok(fine_before).err.find("reusing 6 finished runs"), std::string::npos);
   for (Frame& f : scans.frames)
-    if (f.step == 1) f.position.topRows(2).setConstant(std::nan(""));
+    if (f.step == 0) f.position.topRows(2).setConstant(std::nan(""));
   write_trajectories(in_work("missed.h5"), scans);
   fine[2] = "missed.h5";
   fine[4] = "missed";
+  EXPECT_NE(granmem_ok(fine).err.find("placed where the experiment's frame of cycle 1 has its 60"),
+            std::string::npos);
+  for (Frame& f : scans.frames)
+    if (f.step == 1) f.position.topRows(2).setConstant(std::nan(""));
+  write_trajectories(in_work("missed.h5"), scans);
+  fine[4] = "missed_twice";
   EXPECT_NE(granmem_ok(fine).err.find("deposited at each friction"), std::string::npos);
   // A store whose first frame is after cycle 1, not the packing before the first cycle: the
   // default places it (it precedes the window); placed from cycle 0, refused.
@@ -482,11 +494,12 @@ std::map<std::string, double> json_numbers_under(const std::string& json, const 
   return values;
 }
 
-// Placed from scans (a fine scan's frame, which carries its locating errors), the first
-// refined packing is placed once more from its own frame moved by the scans' error: the
-// placement probe, one of the refined simulations. What it does to the window is carried as
-// the experiment's systematic error (each observable's at least the probe's), and a second
-// call reuses it; a simulation's exact frame needs no probe.
+// Placed from scans (a fine scan's frame, which carries its locating errors) after the drive
+// began, the first refined packing is placed once more from its own frame moved by the scans'
+// error: the placement probe, one of the refined simulations. What it does to the window is
+// carried as the experiment's systematic error (each observable's at least the probe's), and
+// a second call reuses it; a simulation's exact frame needs no probe, nor scans placed from
+// their preparation, which the drive has not trained.
 TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {
   Trajectories scans = read_trajectories(in_work("exp.h5"));
   scans.header.has_position_error = true;
@@ -494,7 +507,8 @@ TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {
     f.position_error = Eigen::RowVector3d::Constant(0.0006 * 0.005).replicate(f.position.rows(), 1);
   write_trajectories(in_work("fine.h5"), scans);
   std::vector<std::string> probed =
-      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only"});
+      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only",
+                 "--placed-cycle", "1"});
   probed[2] = "fine.h5";
   const RunResult r = granmem_ok(probed);
   EXPECT_NE(r.out.find("1 packing(s) more at mu_s "), std::string::npos) << r.out;
@@ -528,6 +542,17 @@ TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {
       calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only"}));
   EXPECT_EQ(exact.out.find("placement probe"), std::string::npos) << exact.out;
   EXPECT_NE(exact.out.find("2 packing(s) more at mu_s "), std::string::npos) << exact.out;
+  // From the scans' preparation (their first frame, the default): no probe either.
+  std::vector<std::string> prepared =
+      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--refine", "2", "--fit-only"});
+  prepared[2] = "fine.h5";
+  prepared[4] = "prepared";
+  const RunResult from_preparation = granmem_ok(prepared);
+  EXPECT_EQ(from_preparation.out.find("placement probe"), std::string::npos)
+      << from_preparation.out;
+  EXPECT_NE(from_preparation.out.find("2 packing(s) more at mu_s "), std::string::npos)
+      << from_preparation.out;
+  EXPECT_EQ(json_value(read_text(in_work("prepared/summary.json")), "placed_cycle"), 0);
 }
 
 TEST_F(Calibrate, FitsMuSAndMuRJointly) {

@@ -86,9 +86,9 @@ TEST(CalibrateOptions, APlacedTwinsRefinedPackingsHoldTheTrendOnBothSidesOfItsFi
 
 class ResolvedOptions : public testing::TempDirTest {
  protected:
-  // A two-grain store of 5 mm grains whose first frame is cycle 0: a simulation's
+  // A two-grain store of 5 mm grains with frames of cycles 0 to `last`: a simulation's
   // (orientations), or a scan's (positions' standard errors of `error`, m).
-  std::filesystem::path store(bool scan, double error = 0) {
+  std::filesystem::path store(bool scan, double error = 0, std::int64_t last = 0) {
     Trajectories t;
     t.header.id = {1, 2};
     t.header.radius = {0.0025, 0.0025};
@@ -103,8 +103,12 @@ class ResolvedOptions : public testing::TempDirTest {
       f.orientation.setZero();
       f.orientation.col(0).setOnes();  // the identity
     }
-    t.frames.push_back(f);
-    const auto p = path(scan ? "scan_" + std::to_string(error) + ".h5" : "sim.h5");
+    for (std::int64_t cycle = 0; cycle <= last; ++cycle) {
+      f.step = cycle;
+      t.frames.push_back(f);
+    }
+    const auto p = path((scan ? "scan_" + std::to_string(error) : std::string("sim")) + "_" +
+                        std::to_string(last) + ".h5");
     write_trajectories(p, t);
     return p;
   }
@@ -137,6 +141,20 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneItsOwn) {
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 3);
   EXPECT_EQ(given.refine, 0);
+}
+
+// A placed twin starts before the window; from scans, at their first frame, the preparation,
+// where it holds the packing: settling centres off by a scan's error into a packing the
+// drive has trained undoes that training (docs/CALIBRATION.md, session 38).
+TEST_F(ResolvedOptions, ScansArePlacedFromTheirPreparation) {
+  CalibrateOptions o;
+  o.window = std::pair<std::int64_t, std::int64_t>{3, 4};
+  EXPECT_EQ(placed_cycle_for(o, TrajectoryReader(store(false, 0, 4))), 2);
+  EXPECT_EQ(placed_cycle_for(o, TrajectoryReader(store(true, 5e-6, 4))), 0);
+  // Too coarse a scan to place at its preparation: before the window, as a simulation.
+  EXPECT_EQ(placed_cycle_for(o, TrajectoryReader(store(true, 25e-6, 4))), 2);
+  o.placed_cycle = 1;  // given: kept
+  EXPECT_EQ(placed_cycle_for(o, TrajectoryReader(store(true, 5e-6, 4))), 1);
 }
 
 }  // namespace

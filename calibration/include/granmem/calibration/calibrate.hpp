@@ -122,16 +122,16 @@ struct CalibrateOptions {
   double placed_jitter = std::nan("");
   // TwinPreparation::experiment: the experiment's cycle whose frame the twin's packings are
   // placed from, its runs driven from the next cycle to the window's last and numbered as
-  // the experiment's. Unset (auto): the cycle before the window (placed_cycle_for()).
+  // the experiment's. Unset (auto): placed_cycle_for().
   std::optional<std::int64_t> placed_cycle;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state: packings added about the design's fit (mu_s, or mu_s and mu_r jointly; at
   // refined_mu_s()), each its own seed (seed + replicas, ...), then the fit made again on every
   // run. They measure one packing's scatter where the experiment is, as realizations
   // independent of the design's, and hold the trend there.
-  // A twin placed from scans (not a simulation's exact frame) makes the last of them its
-  // placement probe instead: the first placed once more from its own frame moved by the
-  // scans' locating error, whose window less that run's is carried as the experiment's
+  // A twin placed from scans (not a simulation's exact frame) after the drive began makes the
+  // last of them its placement probe instead: the first placed once more from its own frame moved
+  // by the scans' locating error, whose window less that run's is carried as the experiment's
   // systematic error (what placing from such a frame does, which 0.5 um replicas do not see).
   // Unset: the design's own (with_default_design()), 0 unless the design is left to it.
   std::optional<int> refine;
@@ -182,7 +182,9 @@ struct CalibrateOptions {
 std::pair<std::int64_t, std::int64_t> compared_window(const CalibrateOptions& options,
                                                       const TrajectoryReader& experiment);
 // The experiment's cycle a placed twin starts from: placed_cycle where given, else the one
-// before the window (with --window auto, chosen from the runs, the experiment's first).
+// before the window; for scans their first frame (the preparation) where it holds the
+// packing (placeable_packing_at()), and with --window auto, chosen from the runs, the
+// experiment's first.
 std::int64_t placed_cycle_for(const CalibrateOptions& options, const TrajectoryReader& experiment);
 // The preparation `options` ask for, automatic resolved for `experiment`.
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
@@ -229,7 +231,7 @@ std::optional<double> parse_axis_noise(const std::string& text, const std::strin
 // --placed-jitter's text: auto (NaN, CalibrateOptions::placed_jitter's default) or a length
 // in m; Error naming `option` otherwise.
 double parse_placed_jitter(const std::string& text, const std::string& option);
-// --placed-cycle's text: auto (unset: the cycle before the window) or a cycle >= 0; Error
+// --placed-cycle's text: auto (unset: placed_cycle_for()) or a cycle >= 0; Error
 // naming `option` otherwise.
 std::optional<std::int64_t> parse_placed_cycle(const std::string& text, const std::string& option);
 

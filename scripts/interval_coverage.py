@@ -5,9 +5,10 @@ in units of its interval's standard deviation, z = ln(mu_s / true) / (ln(high / 
 of the stated width, less for too wide ones), how many hold the truth, and the chance that
 at least that many of so many honest 95 % intervals miss.
 
-Usage: scripts/interval_coverage.py CSV[:COLUMN=VALUE] ...
+Usage: scripts/interval_coverage.py CSV[:COLUMN=VALUE[,COLUMN=VALUE]] ...
 Each CSV (comment lines start with #) has columns true_mu_s, mu_s, ci95_low, ci95_high
-(or a prefix's: both_sides_mu_s, ... with --prefix); COLUMN=VALUE keeps its matching rows."""
+(or a prefix's: both_sides_mu_s, ... with --prefix); COLUMN=VALUE keeps its matching rows
+(every one given)."""
 import argparse
 import csv
 import math
@@ -15,10 +16,10 @@ import math
 
 def rows(spec, prefix):
     path, _, keep = spec.partition(":")
-    column, _, value = keep.partition("=")
+    wanted = [k.partition("=")[::2] for k in keep.split(",") if k]
     with open(path) as f:
         for r in csv.DictReader(line for line in f if not line.startswith("#")):
-            if column and r.get(column) != value:
+            if any(r.get(column) != value for column, value in wanted):
                 continue
             try:
                 yield (r.get("case") or r.get("seed") or "", float(r["true_mu_s"]),

@@ -91,8 +91,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
          "fit x 1.15, the rest at it; poured: all at it), and the fit made again on every run "
          "(they measure one packing's scatter where the experiment is; placed from scans "
          "after the drive began, the last is the placement probe: the first placed again "
-         "from its own frame moved by the scans' error); default 0, but 3 for a steady-state fit "
-         "of mu_s "
+         "from its own frame moved by the scans' error); default 0, but 3 for a steady-state "
+         "fit of mu_s "
          "with --mu-s and --replicas left out (placed 4)")
       ->check(CLI::Range(0, 1000));
   cmd->add_option("--deposit", args->preparation,

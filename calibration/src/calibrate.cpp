@@ -518,7 +518,7 @@ class Twin {
           " does not hold its packing exactly (a scan's centres carry their locating errors, "
           "and grains it missed are taken from later frames): the twin's packings settle from "
           "them; " +
-          (placed_cycle_ > 0
+          (placed_in_a_trained_packing()
                ? std::string("settled into a packing the drive has trained, centres off by "
                              "more than a contact's overlap undo its training: the twin "
                              "compacts faster, and they lean the fit to higher friction (the "
@@ -618,6 +618,9 @@ class Twin {
   bool placed_from_scans() const {
     return placed_ && !exact_packing_at(experiment_, placed_cycle_);
   }
+  // Placed after the drive began (not from the preparation): a frame the drive has trained,
+  // whose training centres off by a scan's error undo as they settle.
+  bool placed_in_a_trained_packing() const { return placed_cycle_ > 0; }
 
   // The placement probe: the run `source` placed once more, from its own frame of the placed
   // cycle moved by a draw of the scans' locating error `error` (m, along x, y, z), at its
@@ -1502,8 +1505,8 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
   auto [at, line, scan_error] = design_fit(twin, specs);
   // Placed from scans (their error read) after the drive has begun, one of the packings is the
   // placement probe; placed from the preparation there is no training for the error to undo.
-  const bool probe = !o.joint() && o.refined_packings() >= 2 && twin.first_cycle() > 0 &&
-                     (scan_error.array() > 0).any();
+  const bool probe = !o.joint() && o.refined_packings() >= 2 &&
+                     twin.placed_in_a_trained_packing() && (scan_error.array() > 0).any();
   const int packings = o.refined_packings() - (probe ? 1 : 0);
   if (!interior(at.mu_s, o.mu_s) || (o.joint() && !interior(at.mu_r, o.mu_r))) {
     line += "not refined: the fit is at the edge of the frictions simulated (widen the range)";

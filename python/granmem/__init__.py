@@ -342,8 +342,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     about the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design (placed: one at fit /
     1.15, one at fit x 1.15, the rest at it; poured: all at it), and the fit made again on
     every run (``None``: 0, but for a steady-state fit of mu_s whose ``mu_s`` and ``replicas``
-    are left to it 3, placed 4; placed from scans after the drive began, the last is the placement probe, the first
-    placed again from its own frame moved by the scans' error). ``axis_noise``
+    are left to it 3, placed 4; placed from scans after the drive began, the last is the
+    placement probe, the first placed again from its own frame moved by the scans' error). ``axis_noise``
     (steady-state, degrees): the experiment's error in each hole axis (a scan's), added to
     the twin's exact axes before their rotations are measured;
     "auto": the scans' own RMS axis standard error where the store has them, else none.

@@ -133,13 +133,16 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                   "rotation, the packing fraction from "
                   "the packing's height and in its bulk, the coordination, all from positions, "
                   "and the wall force at full compression and at the cycle's end where the "
-                  "experiment has them (docs/CALIBRATION.md)")
+                  "experiment has them; for a twin placed before the frame before the window "
+                  "(the scans' preparation), the packing's height at that frame too "
+                  "(docs/CALIBRATION.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"displacements", "steady-state"}));
   cmd->add_option("--only", args->only,
                   "steady-state: fit only these observables, comma list (dr, rot_disp, "
                   "bulk_packing_fraction, coordination, height_packing_fraction, "
-                  "packing_fraction, wall_force_full_compression, wall_force_unloaded); "
+                  "height_packing_fraction_before_window, packing_fraction, "
+                  "wall_force_full_compression, wall_force_unloaded); "
                   "default all the experiment has, the lid's packing_fraction left out where "
                   "the height's is there");
   cmd->add_option("--fit", args->fit,

@@ -440,7 +440,18 @@ class Twin {
   // with fewer contacts. The packing's height with the twin's
   // grain count, the experiment's own: grains a scan misses would read as a looser packing.
   SteadyState measured_steady_state() const {
-    return steady_state(experiment_, measured, {}, known_grains());
+    SteadyState s = steady_state(experiment_, measured, {}, known_grains());
+    if (const auto cycle = cycle_before_window())
+      add_height_before_window(s, experiment_, *cycle, known_grains());
+    return s;
+  }
+  // The frame before the window where the twin was placed from an earlier one (the scans'
+  // preparation) and the experiment has it: the packing's height there is compared too.
+  std::optional<std::int64_t> cycle_before_window() const {
+    const std::int64_t before = observe.window.first - 1;
+    if (!placed_ || placed_cycle_ >= before || !frame_of_cycle(experiment_, before))
+      return std::nullopt;
+    return before;
   }
   KnownGrains known_grains() const {
     KnownGrains known;
@@ -900,8 +911,13 @@ SteadyState twin_run_steady_state(const Twin& twin, const fs::path& path,
   ObservableOptions observe = twin.observe;
   observe.position_noise = displacement_noise;
   const TrajectoryReader r(path);
-  return steady_state(r, cycle_observables(r, observe), {}, {},
-                      run_position_noise(spec, position_noise, r));
+  PositionNoise noise = run_position_noise(spec, position_noise, r);
+  SteadyState s = steady_state(r, cycle_observables(r, observe), {}, {}, noise);
+  if (const auto cycle = twin.cycle_before_window()) {
+    noise.seed = fnv1a(&*cycle, sizeof *cycle, noise.seed);  // that frame's own draws
+    add_height_before_window(s, r, *cycle, {}, noise);
+  }
+  return s;
 }
 
 // The twin's runs' steady states. `position_noise` (m, along x, y and z): the scans'
@@ -1156,13 +1172,15 @@ PlacedReadBack placed_read_back(const Twin& twin, const std::vector<SteadyStateR
 }
 
 // The experiment's steady state with a placed packing's read-back and its placement probe's
-// effect (where there is one) as its systematic errors, in quadrature.
+// effect (where there is one) as its systematic errors, in quadrature; an observable read at
+// the frame before the window carries its structure's read-back, as the window's does.
 SteadyState with_systematic(SteadyState experiment, const PlacedReadBack& placed,
                             const SteadyState& probe) {
   experiment.systematic.assign(experiment.names.size(), 0.0);
   for (std::size_t k = 0; k < experiment.names.size(); ++k) {
     double sum = 0;
-    for (double d : {placed.less_experiment[experiment.names[k]], probe[experiment.names[k]]})
+    const std::string& name = experiment.names[k];
+    for (double d : {placed.less_experiment[structure_read_as(name)], probe[name]})
       if (std::isfinite(d)) sum += d * d;
     experiment.systematic[k] = std::sqrt(sum);
   }
@@ -1242,7 +1260,9 @@ std::vector<NoiseLimited> noise_limited(const Twin& twin, const std::vector<std:
     const bool modelled = rotation_k       ? twin.observe.axis_noise > 0
                           : displacement_k ? displacements_modelled
                                            : positions_modelled;
-    const double d = rotation_k ? rotation : displacement_k ? displacement : effect[names[k]];
+    const double d = rotation_k       ? rotation
+                     : displacement_k ? displacement
+                                      : effect[structure_read_as(names[k])];
     if (std::isfinite(d) &&
         std::abs(d) * (modelled ? kModelledNoise : 1) > (modelled ? 1 : kNoiseShare) * scatter[k])
       limited.push_back({names[k], d, scatter[k], modelled});

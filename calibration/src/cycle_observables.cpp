@@ -223,6 +223,8 @@ std::string steady_state_label(const std::string& name) {
       {"bulk_packing_fraction", "bulk packing fraction (positions)"},
       {"coordination", "coordination number (positions)"},
       {"height_packing_fraction", "packing fraction (positions' height)"},
+      {"height_packing_fraction_before_window",
+       "packing fraction (positions' height), the frame before the window"},
       {"packing_fraction", "packing fraction (lid height)"},
       {"wall_force_full_compression", "wall force at full compression (N)"},
       {"wall_force_unloaded", "wall force at the cycle's end (N)"}};
@@ -365,6 +367,25 @@ SteadyState frame_structure(const TrajectoryReader& run, std::int64_t cycle,
   SteadyState at = window_means(s, {cycle, cycle});
   at.drift.assign(at.values.size(), 0.0);
   return at;
+}
+
+namespace {
+constexpr char kBeforeWindow[] = "_before_window";
+}
+
+void add_height_before_window(SteadyState& s, const TrajectoryReader& run, std::int64_t cycle,
+                              const KnownGrains& known, const PositionNoise& noise) {
+  const std::string name = "height_packing_fraction";
+  s.names.push_back(name + kBeforeWindow);
+  s.values.push_back(frame_structure(run, cycle, {}, known, noise)[name]);
+  s.drift.push_back(0.0);
+}
+
+std::string structure_read_as(const std::string& name) {
+  const std::string suffix = kBeforeWindow;
+  const bool before = name.size() > suffix.size() &&
+                      name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return before ? name.substr(0, name.size() - suffix.size()) : name;
 }
 
 SteadyState steady_state(const TrajectoryReader& run, const CycleObservables& observed,

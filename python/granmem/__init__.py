@@ -336,7 +336,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     with Ceres so that the twin's ``observables`` match the experiment's over ``window``
     (``(first, last)`` cycles; default its last 10; "auto" with steady-state: the longest
     window ending there over which the twin's runs are steady): "steady-state" (the default:
-    window means of displacement, rotation, packing fraction, coordination, wall force; ``only`` a
+    window means of displacement, rotation, packing fraction, coordination, wall force, and for
+    a twin placed before the frame before the window the packing's height there; ``only`` a
     subset) or "displacements" (the end-of-cycle displacement distribution). docs/CALIBRATION.md says which
     identify friction. ``refine`` (steady-state): that many packings more, each its own seed,
     about the fit of the ``mu_s`` (x ``mu_r``) x ``replicas`` design (placed: one at fit /

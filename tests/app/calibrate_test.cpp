@@ -306,6 +306,22 @@ TEST_F(Calibrate, RefinesTheDesignWithNewPackingsAboutItsFit) {
   EXPECT_TRUE(std::filesystem::exists(in_work("shared/packing_seed_4.checkpoint.h5")));
 }
 
+// The "name": value pairs of summary.json's object under `key` (one level, numbers only).
+std::map<std::string, double> json_numbers_under(const std::string& json, const std::string& key) {
+  std::map<std::string, double> values;
+  const auto at = json.find("\"" + key + "\":");
+  if (at == std::string::npos) return values;
+  const auto open = json.find('{', at), close = json.find('}', open);
+  if (open == std::string::npos || close == std::string::npos) return values;
+  for (auto q = json.find('"', open); q < close; q = json.find('"', json.find(',', q))) {
+    const auto end = json.find('"', q + 1);
+    if (end == std::string::npos || end + 2 >= json.size()) break;
+    values[json.substr(q + 1, end - q - 1)] = std::strtod(json.c_str() + end + 2, nullptr);
+    if (json.find(',', q) > close) break;
+  }
+  return values;
+}
+
 // --deposit experiment: every run starts from the experiment's own packing, the grains of
 // its frame before the window jittered by the run's seed and settled at the run's friction,
 // and drives the cycles after it: at the true friction the twin starts where the experiment
@@ -356,6 +372,24 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   const std::string started_run = in_work("start/runs/mu_s_0.2_seed_1.h5");
   EXPECT_EQ(TrajectoryReader(started_run).steps().front(), 0);
   EXPECT_NEAR(height_at(started_run, 0), height_at(in_work("exp.h5"), 0), 0.01 * d);
+  // Placed before the frame before the window, the twin and the experiment share their start
+  // there: the packing's height at that frame is compared too, and the runs at the true
+  // friction read the experiment's far nearer than those at half or twice it. Placed from
+  // that frame itself (the design above), it is not compared.
+  const std::string before = "height_packing_fraction_before_window";
+  const double experiment_before =
+      json_numbers_under(read_text(in_work("start/summary.json")), before).at("experiment");
+  const Table runs = read_columns(in_work("start/steady_state_runs.csv"), {"mu_s", before});
+  double off_at_truth = 0, off_elsewhere = 1;
+  for (std::size_t k = 0; k < runs["mu_s"].values.size(); ++k) {
+    const double off = std::abs(runs[before].values[k] - experiment_before);
+    if (runs["mu_s"].values[k] == 0.2)
+      off_at_truth = std::max(off_at_truth, off);
+    else
+      off_elsewhere = std::min(off_elsewhere, off);
+  }
+  EXPECT_LT(off_at_truth, 0.2 * off_elsewhere) << off_at_truth << " " << off_elsewhere;
+  EXPECT_EQ(csv_header(in_work("cal/steady_state_runs.csv")).find(before), std::string::npos);
   from_start.back() = "2";
   expect_clean_failure(from_start, {"--placed-cycle 2", "before the window"});
   from_start.back() = "first";
@@ -476,22 +510,6 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
   from_later.insert(from_later.end(), {"--deposit", "experiment", "--placed-cycle", "0"});
   expect_clean_failure(from_later, {"later.h5", "--deposit experiment", "frame of cycle 0",
                                     "(--placed-cycle)", "has none"});
-}
-
-// The "name": value pairs of summary.json's object under `key` (one level, numbers only).
-std::map<std::string, double> json_numbers_under(const std::string& json, const std::string& key) {
-  std::map<std::string, double> values;
-  const auto at = json.find("\"" + key + "\":");
-  if (at == std::string::npos) return values;
-  const auto open = json.find('{', at), close = json.find('}', open);
-  if (open == std::string::npos || close == std::string::npos) return values;
-  for (auto q = json.find('"', open); q < close; q = json.find('"', json.find(',', q))) {
-    const auto end = json.find('"', q + 1);
-    if (end == std::string::npos || end + 2 >= json.size()) break;
-    values[json.substr(q + 1, end - q - 1)] = std::strtod(json.c_str() + end + 2, nullptr);
-    if (json.find(',', q) > close) break;
-  }
-  return values;
 }
 
 // Placed from scans (a fine scan's frame, which carries its locating errors) after the drive

@@ -259,6 +259,19 @@ TEST_F(SteadyStateTest, AFramesStructureIsThatFramesAlone) {
   const SteadyState moved = structure_noise_effect(run, {1, 1}, noise.sigma, {}, {}, noise.seed);
   for (const std::string& name : moved.names)
     EXPECT_NEAR(noisy[name], touching[name] + moved[name], 1e-12) << name;
+  // The packing's height at the frame before a window, beside the window's: that frame's
+  // alone, read back (for its read-back and noise) as the structure it is.
+  SteadyState s;
+  add_height_before_window(s, run, 2);
+  add_height_before_window(s, run, 1, {}, noise);
+  EXPECT_EQ(s.names, std::vector<std::string>(2, "height_packing_fraction_before_window"));
+  EXPECT_DOUBLE_EQ(s.values[0], apart["height_packing_fraction"]);
+  EXPECT_DOUBLE_EQ(s.values[1], noisy["height_packing_fraction"]);
+  EXPECT_EQ(s.drift, std::vector<double>(2, 0.0));
+  EXPECT_EQ(structure_read_as(s.names[0]), "height_packing_fraction");
+  EXPECT_EQ(structure_read_as("height_packing_fraction"), "height_packing_fraction");
+  EXPECT_EQ(structure_read_as("_before_window"), "_before_window");
+  EXPECT_THROW(add_height_before_window(s, run, 7), Error);
 }
 
 // compare's options (the window and wall distance it pools these observables with),

@@ -93,6 +93,8 @@ DisplacementField full_compression_field(const TrajectoryReader& end_of_cycle,
 //   wall_force_full_compression  N (the store's)
 //   wall_force_unloaded          N: the store's wall force at each cycle's end, the wall back
 //                                at its start (the packing's lateral stress once unloaded)
+// and, for a twin placed before the frame before the window (add_height_before_window):
+//   height_packing_fraction_before_window   that frame's height_packing_fraction
 struct SteadyState {
   std::vector<std::string> names;
   std::vector<double> values;
@@ -167,6 +169,18 @@ std::optional<std::size_t> frame_of_cycle(const TrajectoryReader& run, std::int6
 SteadyState frame_structure(const TrajectoryReader& run, std::int64_t cycle,
                             const StructureOptions& structure = {}, const KnownGrains& known = {},
                             const PositionNoise& noise = {});
+// A twin placed from an earlier frame than the one before the window (the scans'
+// preparation) and the experiment share that start, and the packing's chaos grows with the
+// cycles from it: its height at the frame before the window carries the compaction so far
+// with less of the chaos than the window's mean does (docs/CALIBRATION.md, "The packing's
+// height before the window"). Appends that frame's height_packing_fraction to `s` as
+// "height_packing_fraction_before_window" (no drift); Error if the run has no such frame.
+void add_height_before_window(SteadyState& s, const TrajectoryReader& run, std::int64_t cycle,
+                              const KnownGrains& known = {}, const PositionNoise& noise = {});
+// The observable from positions a steady-state name reads at another frame
+// ("height_packing_fraction" for "height_packing_fraction_before_window"); the name itself
+// for the rest.
+std::string structure_read_as(const std::string& name);
 // What a steady-state observable is, with its unit, for tables and figures ("wall force at
 // full compression (N)"); the name itself for one it does not know.
 std::string steady_state_label(const std::string& name);

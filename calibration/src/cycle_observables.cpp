@@ -223,8 +223,7 @@ std::string steady_state_label(const std::string& name) {
       {"bulk_packing_fraction", "bulk packing fraction (positions)"},
       {"coordination", "coordination number (positions)"},
       {"height_packing_fraction", "packing fraction (positions' height)"},
-      {"height_packing_fraction_before_window",
-       "packing fraction (positions' height), the frame before the window"},
+      {"height_packing_fraction_before_window", "packing fraction (height before window)"},
       {"packing_fraction", "packing fraction (lid height)"},
       {"wall_force_full_compression", "wall force at full compression (N)"},
       {"wall_force_unloaded", "wall force at the cycle's end (N)"}};

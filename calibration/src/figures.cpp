@@ -266,8 +266,11 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
                                           std::array<double, 2> ci95, double true_mu_s,
                                           const std::string& title) {
   if (panels.empty()) throw Error("observable fit figure: no observable");
-  const int columns = panels.size() > 4 ? 3 : std::min<int>(2, int(panels.size()));
-  const int rows = (int(panels.size()) + columns - 1) / columns;
+  // The panels and, in the slot after them, the key alone: beside the last panel it would
+  // run out of the figure wherever that is in the last column.
+  const int slots = int(panels.size()) + 1;
+  const int columns = slots <= 4 ? 2 : slots <= 6 || slots == 9 ? 3 : 4;
+  const int rows = (slots + columns - 1) / columns;
   // The range: the design's frictions and the fit, with the interval where it is finite
   // (one that reaches 0 or infinity, an observable that cannot bound it, runs to the edge).
   double lowest = mu_s, highest = mu_s;
@@ -312,22 +315,22 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
          << " behind fc rgb \"#92c5de\" fs solid 0.45 noborder\n"
          << "set arrow 3 from graph 0, first " << panel.experiment << " to graph 1, first "
          << panel.experiment << " nohead lw 1.5 lc rgb \"#2166ac\"\n";
-    if (p + 1 == panels.size()) {
-      plot << "set key outside bottom center horizontal\n";
-    }
     plot << "plot " << quoted(name + ".dat") << " index " << 2 * p
-         << " using 1:2:3 with points pt 7 ps 1.2 lc variable title \"twin runs (colour: "
-            "packing)\", "
-         << quoted(name + ".dat") << " index " << 2 * p + 1
-         << " using 1:2 with lines lw 2 lc rgb \"#404040\" title \"trend\", "
-         << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- packing, systematic\", "
-         << "NaN with lines lw 8 lc rgb \"#f4a582\" title \"fitted mu_s, 95 %\""
-         << (std::isfinite(true_mu_s)
-                 ? ", NaN with lines lw 2 dt 2 lc rgb \"black\" title \"true mu_s\""
-                 : "")
-         << "\n";
+         << " using 1:2:3 with points pt 7 ps 1.2 lc variable, " << quoted(name + ".dat")
+         << " index " << 2 * p + 1 << " using 1:2 with lines lw 2 lc rgb \"#404040\"\n";
   }
-  plot << "unset multiplot\n";
+  plot << "unset object 1\nunset object 2\nunset arrow 1\nunset arrow 2\nunset arrow 3\n"
+       << "unset border\nunset tics\nunset grid\nunset xlabel\nunset ylabel\nunset logscale\n"
+       << "set xrange [0:1]\nset yrange [0:1]\nset key center center vertical Left reverse\n"
+       << "plot NaN with points pt 7 ps 1.2 lc 1 title \"twin runs (colour: packing)\", "
+       << "NaN with lines lw 2 lc rgb \"#404040\" title \"trend\", "
+       << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- packing, systematic\", "
+       << "NaN with lines lw 8 lc rgb \"#f4a582\" title \"fitted mu_s, 95 %\", "
+       << "NaN with lines lw 2 lc rgb \"#b2182b\" title \"fitted mu_s\""
+       << (std::isfinite(true_mu_s)
+               ? ", NaN with lines lw 2 dt 2 lc rgb \"black\" title \"true mu_s\""
+               : "")
+       << "\nunset multiplot\n";
   const std::string size = std::to_string(420 * columns) + "," + std::to_string(330 * rows + 60);
   return draw(dir, name, data.str(), plot.str(), size);
 }

@@ -54,6 +54,9 @@ TEST_F(Figures, AnUnboundedIntervalIsDrawnToTheEdges) {
   const std::string gp = read_all(dir_ / "fit.gp");
   EXPECT_EQ(gp.find("inf"), std::string::npos) << gp;
   EXPECT_NE(gp.find("set xrange [0.04:0.5]"), std::string::npos) << gp;
+  // The key in the slot after the panels, not beside the last of them.
+  EXPECT_NE(gp.find("set multiplot layout 1,2"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("set key center center"), std::string::npos) << gp;
 }
 
 // The frictions' tics are the design's own, but no two labels nearer than a label's width

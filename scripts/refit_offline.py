@@ -13,8 +13,15 @@ share beside it; Student's t for the spare or held-out runs. It reproduces calib
 interval to ~1e-4 on the scanned cases; it is a check, not the fit.
 
   scripts/refit_offline.py FIT_DIR [--without NAME[,NAME]] ...
+  scripts/refit_offline.py --calibration [--null DRAWS] FIT_DIR ...
 
-prints, per folder: the truth, calibrate's fit, and this one (with NAMEs left out).
+prints, per folder: the truth, calibrate's fit, and this one (with NAMEs left out). With
+--calibration, how honest the interval is (docs/CALIBRATION.md, "How wide the intervals are
+against the errors"): the fit's error in ln mu_s over the GLS sigma (the Fisher information
+of the runs' covariance, with the systematic errors) and over the interval's, and the
+held-out runs' ratios (the cross-validation's) split into the design's packings and the
+refined ones; --null adds the same from Gaussian draws about the fitted trend with the shrunk
+covariance, where the experiment is by construction one more packing.
 """
 import argparse
 import csv
@@ -74,34 +81,49 @@ def least_chi2(x, values, target, systematic2, degree):
     return trend, best, chi2(best)
 
 
-def fit(x, seeds, values, target, systematic, degree):
-    systematic2 = systematic ** 2
+def held_out_ratios(x, seeds, values, degree, trend):
+    """Each interior run fitted from the other seeds' runs: its error in ln mu_s over the
+    error the trend through all runs predicts there, by run index."""
+    none = np.zeros(values.shape[1])
+    ratios = {}
+    for i in range(len(x)):
+        others = seeds != seeds[i]
+        if others.sum() < degree + 2 or not x[others].min() < x[i] < x[others].max():
+            continue
+        _, held_out, _ = least_chi2(x[others], values[others], values[i], none, degree)
+        ratios[i] = (held_out - x[i]) / np.sqrt(trend.variance(x[i], none))
+    return ratios
+
+
+def gls(x, values, target, systematic2, degree):
+    """ln mu_s where the generalized chi-square is least, and its variance from the Fisher
+    information, widened by chi2 / dof on a misfit (Birge)."""
     trend, g, chi2 = least_chi2(x, values, target, systematic2, degree)
     dof = len(target) - 1
     widened = max(1.0, chi2 / dof) if dof > 0 else 1.0
-    variance = trend.variance(g, systematic2) * widened
+    return trend, g, chi2, trend.variance(g, systematic2) * widened, widened
+
+
+def fit(x, seeds, values, target, systematic, degree):
+    systematic2 = systematic ** 2
+    trend, g, chi2, variance, widened = gls(x, values, target, systematic2, degree)
     c_inv = np.linalg.inv(trend.covariance(g, systematic2))
     s = trend.slope(g)
     weights = (s @ c_inv) / (s @ c_inv @ s)
     systematic_variance = weights @ np.diag(systematic2) @ weights * widened
     sigma, t = np.sqrt(variance), stats.t.ppf(0.975, trend.spare)
     none = np.zeros_like(systematic2)
-    ratios = []
-    for i in range(len(x)):
-        others = seeds != seeds[i]
-        if others.sum() < degree + 2 or not x[others].min() < x[i] < x[others].max():
-            continue
-        _, held_out, _ = least_chi2(x[others], values[others], values[i], none, degree)
-        ratios.append((held_out - x[i]) ** 2 / trend.variance(x[i], none))
+    ratios = [r ** 2 for r in held_out_ratios(x, seeds, values, degree, trend).values()]
     cross_validated = np.sqrt(np.mean(ratios) * trend.variance(g, none)) if ratios else 0.0
     if ratios and cross_validated > np.sqrt(max(0.0, variance - systematic_variance)):
         sigma = np.hypot(cross_validated, np.sqrt(systematic_variance))
         t = stats.t.ppf(0.975, len(ratios))
     return {"mu_s": np.exp(g), "low": np.exp(g - t * sigma), "high": np.exp(g + t * sigma),
-            "chi2": chi2, "sigma": sigma, "cross_validated": cross_validated}
+            "chi2": chi2, "sigma": sigma, "gls_sigma": np.sqrt(variance),
+            "cross_validated": cross_validated}
 
 
-def refit(folder, without):
+def read(folder, without):
     summary = json.load(open(f"{folder}/summary.json"))
     observables = summary["observables"]
     names = [n for n, o in observables.items() if "model_at_fit" in o and n not in without]
@@ -113,15 +135,88 @@ def refit(folder, without):
     target = np.array([observables[n]["experiment"] for n in names])
     systematic = np.array([observables[n]["experiment_systematic"] for n in names])
     degree = int(re.search(r"degree (\d)", summary["mu_s_interval_method"]).group(1))
-    return summary, fit(x, seeds, values, target, systematic, degree)
+    return summary, (x, seeds, values, target, systematic, degree)
+
+
+def refit(folder, without):
+    summary, data = read(folder, without)
+    return summary, fit(*data)
+
+
+def design_seeds(summary, seeds):
+    """The staged design's seeds (its first `replicas`); the refined packings' are the rest."""
+    return np.isin(seeds, np.unique(seeds)[: summary["replicas"]])
+
+
+def rms(values):
+    return float(np.sqrt(np.mean(np.square(values)))) if len(values) else float("nan")
+
+
+def calibration(folder, without, draws, rng):
+    """The experiment's error in units of the GLS sigma and of the interval's, beside the
+    held-out runs' (design and refined packings apart); with `draws`, the same from the
+    Gaussian null: runs and an experiment at the truth drawn about the fitted trend with the
+    shrunk covariance."""
+    summary, (x, seeds, values, target, systematic, degree) = read(folder, without)
+    f = fit(x, seeds, values, target, systematic, degree)
+    truth = np.log(summary["mu_s_true"])
+    trend = Trend(x, values, degree)
+    design = design_seeds(summary, seeds)
+    held = held_out_ratios(x, seeds, values, degree, trend)
+    row = {"z_gls": np.log(f["mu_s"]) - truth, "z_interval": np.log(f["mu_s"]) - truth}
+    row["z_gls"] /= f["gls_sigma"]
+    row["z_interval"] /= f["sigma"]
+    row["held_out_design"] = [r for i, r in held.items() if design[i]]
+    row["held_out_refined"] = [r for i, r in held.items() if not design[i]]
+    null = {"z_gls": [], "held_out_design": [], "held_out_refined": []}
+    root = np.linalg.cholesky(trend.cov)
+    none = np.zeros(values.shape[1])
+    for _ in range(draws):
+        drawn = np.vander(x, degree + 1) @ trend.coef + rng.standard_normal(values.shape) @ root.T
+        experiment = trend.predict(truth) + root @ rng.standard_normal(values.shape[1])
+        t, g, _, variance, _ = gls(x, drawn, experiment, none, degree)
+        null["z_gls"].append((g - truth) / np.sqrt(variance))
+        for i, r in held_out_ratios(x, seeds, drawn, degree, t).items():
+            null["held_out_design" if design[i] else "held_out_refined"].append(r)
+    return summary, row, null
+
+
+def main_calibration(folders, without, draws):
+    print("folder,true_mu_s,z_gls,z_interval,held_out_design_rms,held_out_refined_rms"
+          + (",null_z_gls_rms,null_design_rms,null_refined_rms" if draws else ""))
+    rng = np.random.default_rng(1)
+    pooled = {k: [] for k in ("z_gls", "z_interval", "held_out_design", "held_out_refined",
+                              "null_z_gls", "null_held_out_design", "null_held_out_refined")}
+    for folder in folders:
+        s, row, null = calibration(folder, without, draws, rng)
+        line = (f"{folder},{s['mu_s_true']},{row['z_gls']:+.2f},{row['z_interval']:+.2f},"
+                f"{rms(row['held_out_design']):.2f},{rms(row['held_out_refined']):.2f}")
+        if draws:
+            line += "," + ",".join(f"{rms(null[k]):.2f}" for k in null)
+        print(line)
+        for k in ("z_gls", "z_interval"):
+            pooled[k].append(row[k])
+        for k in ("held_out_design", "held_out_refined"):
+            pooled[k] += row[k]
+        for k, v in null.items():
+            pooled["null_" + k] += v
+    print("# RMS over the folders: " + ", ".join(f"{k} {rms(v):.2f} ({len(v)})"
+                                                 for k, v in pooled.items() if v))
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("folders", nargs="+")
     parser.add_argument("--without", default="", help="observables left out, comma list")
+    parser.add_argument("--calibration", action="store_true",
+                        help="the errors in units of the GLS's and the interval's sigma, and "
+                             "the held-out runs' (pseudo-experiments: mu_s_true in summary)")
+    parser.add_argument("--null", type=int, default=0, metavar="DRAWS",
+                        help="with --calibration: as many Gaussian-null draws per folder")
     a = parser.parse_args()
     without = [n for n in a.without.split(",") if n]
+    if a.calibration:
+        return main_calibration(a.folders, without, a.null)
     print("folder,true_mu_s,calibrate_mu_s,calibrate_low,calibrate_high,mu_s,low,high,width,"
           "chi2,cross_validated_sigma")
     for folder in a.folders:

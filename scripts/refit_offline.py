@@ -13,7 +13,7 @@ share beside it; Student's t for the spare or held-out runs. It reproduces calib
 interval to ~1e-4 on the scanned cases; it is a check, not the fit.
 
   scripts/refit_offline.py FIT_DIR [--without NAME[,NAME]] ...
-  scripts/refit_offline.py --calibration [--null DRAWS] FIT_DIR ...
+  scripts/refit_offline.py --calibration [--null DRAWS [--bootstrap]] FIT_DIR ...
 
 prints, per folder: the truth, calibrate's fit, and this one (with NAMEs left out). With
 --calibration, how honest the interval is (docs/CALIBRATION.md, "How wide the intervals are
@@ -21,7 +21,8 @@ against the errors"): the fit's error in ln mu_s over the GLS sigma (the Fisher 
 of the runs' covariance, with the systematic errors) and over the interval's, and the
 held-out runs' ratios (the cross-validation's) split into the design's packings and the
 refined ones; --null adds the same from Gaussian draws about the fitted trend with the shrunk
-covariance, where the experiment is by construction one more packing.
+covariance (--bootstrap: the runs' own residuals resampled), where the experiment is by
+construction one more packing.
 """
 import argparse
 import csv
@@ -152,11 +153,23 @@ def rms(values):
     return float(np.sqrt(np.mean(np.square(values)))) if len(values) else float("nan")
 
 
-def calibration(folder, without, draws, rng):
+def residual_draws(x, values, trend, degree, bootstrap, rng):
+    """Draws of the runs' deviations from their trend and one more packing's: Gaussian with
+    the shrunk covariance, or (bootstrap) the runs' own residual vectors, each inflated by
+    1 / sqrt(1 - leverage), resampled whole."""
+    if bootstrap:
+        design = np.vander(x, degree + 1)
+        leverage = np.einsum("ij,jk,ik->i", design, trend.inverse_gram, design)
+        residual = (values - design @ trend.coef) / np.sqrt(1 - leverage)[:, None]
+        return lambda n: residual[rng.integers(0, len(x), n)]
+    root = np.linalg.cholesky(trend.cov)
+    return lambda n: rng.standard_normal((n, values.shape[1])) @ root.T
+
+
+def calibration(folder, without, draws, bootstrap, rng):
     """The experiment's error in units of the GLS sigma and of the interval's, beside the
-    held-out runs' (design and refined packings apart); with `draws`, the same from the
-    Gaussian null: runs and an experiment at the truth drawn about the fitted trend with the
-    shrunk covariance."""
+    held-out runs' (design and refined packings apart); with `draws`, the same from a null:
+    runs and an experiment at the truth drawn about the fitted trend (residual_draws)."""
     summary, (x, seeds, values, target, systematic, degree) = read(folder, without)
     f = fit(x, seeds, values, target, systematic, degree)
     truth = np.log(summary["mu_s_true"])
@@ -169,11 +182,11 @@ def calibration(folder, without, draws, rng):
     row["held_out_design"] = [r for i, r in held.items() if design[i]]
     row["held_out_refined"] = [r for i, r in held.items() if not design[i]]
     null = {"z_gls": [], "held_out_design": [], "held_out_refined": []}
-    root = np.linalg.cholesky(trend.cov)
+    deviations = residual_draws(x, values, trend, degree, bootstrap, rng)
     none = np.zeros(values.shape[1])
     for _ in range(draws):
-        drawn = np.vander(x, degree + 1) @ trend.coef + rng.standard_normal(values.shape) @ root.T
-        experiment = trend.predict(truth) + root @ rng.standard_normal(values.shape[1])
+        drawn = np.vander(x, degree + 1) @ trend.coef + deviations(len(x))
+        experiment = trend.predict(truth) + deviations(1)[0]
         t, g, _, variance, _ = gls(x, drawn, experiment, none, degree)
         null["z_gls"].append((g - truth) / np.sqrt(variance))
         for i, r in held_out_ratios(x, seeds, drawn, degree, t).items():
@@ -181,14 +194,14 @@ def calibration(folder, without, draws, rng):
     return summary, row, null
 
 
-def main_calibration(folders, without, draws):
+def main_calibration(folders, without, draws, bootstrap):
     print("folder,true_mu_s,z_gls,z_interval,held_out_design_rms,held_out_refined_rms"
           + (",null_z_gls_rms,null_design_rms,null_refined_rms" if draws else ""))
     rng = np.random.default_rng(1)
     pooled = {k: [] for k in ("z_gls", "z_interval", "held_out_design", "held_out_refined",
                               "null_z_gls", "null_held_out_design", "null_held_out_refined")}
     for folder in folders:
-        s, row, null = calibration(folder, without, draws, rng)
+        s, row, null = calibration(folder, without, draws, bootstrap, rng)
         line = (f"{folder},{s['mu_s_true']},{row['z_gls']:+.2f},{row['z_interval']:+.2f},"
                 f"{rms(row['held_out_design']):.2f},{rms(row['held_out_refined']):.2f}")
         if draws:
@@ -213,10 +226,12 @@ def main():
                              "the held-out runs' (pseudo-experiments: mu_s_true in summary)")
     parser.add_argument("--null", type=int, default=0, metavar="DRAWS",
                         help="with --calibration: as many Gaussian-null draws per folder")
+    parser.add_argument("--bootstrap", action="store_true",
+                        help="with --null: the runs' own residuals resampled, not Gaussian")
     a = parser.parse_args()
     without = [n for n in a.without.split(",") if n]
     if a.calibration:
-        return main_calibration(a.folders, without, a.null)
+        return main_calibration(a.folders, without, a.null, a.bootstrap)
     print("folder,true_mu_s,calibrate_mu_s,calibrate_low,calibrate_high,mu_s,low,high,width,"
           "chi2,cross_validated_sigma")
     for folder in a.folders:

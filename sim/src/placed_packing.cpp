@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,33 +14,74 @@
 namespace granmem {
 namespace {
 
-// `frame`, each grain it misses taken (position, orientation, axis) from the first later
-// frame that has it (NaN if none), unless a grain already placed lies within `reach` of it
-// there: two grains' centres are a diameter apart, so it is that grain, whose track the
-// linker broke across the scans between (on tracked scans of cycles 0 and 20-30, 3 of
-// 2,500 tracks, 0.43-0.70 d from a placed grain), or a grain that cannot be placed there.
-Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double reach) {
-  Frame f = run.read_frame(frame);
-  std::vector<bool> taken(std::size_t(f.position.rows()), false);
-  auto missing = [&] {  // a grain no later frame has decided yet
-    for (Eigen::Index i = 0; i < f.position.rows(); ++i)
-      if (!f.position.row(i).allFinite() && !taken[std::size_t(i)]) return true;
-    return false;
-  };
-  for (std::size_t t = frame + 1; t < run.frame_count() && missing(); ++t) {
-    const Frame later = run.read_frame(t);
-    const PointIndex placed(finite_rows(f.position));
-    PointIndex::Hits near;
+// A grain a frame misses, as the first later frame that has it holds it (position,
+// orientation, axis), and its clearance: how far that lies from the nearest grain the frame
+// holds.
+struct LaterGrain {
+  Eigen::Index row;
+  Eigen::RowVector3d position, axis;  // axis: NaN where the run has none
+  Eigen::RowVector4d orientation;     // NaN where the run has none
+  double clearance;
+};
+
+LaterGrain later_grain(const Frame& next, Eigen::Index i, double clearance) {
+  LaterGrain g{i, next.position.row(i), Eigen::RowVector3d::Constant(NAN),
+               Eigen::RowVector4d::Constant(NAN), clearance};
+  if (next.axis.rows() > i) g.axis = next.axis.row(i);
+  if (next.orientation.rows() > i) g.orientation = next.orientation.row(i);
+  return g;
+}
+
+std::vector<LaterGrain> missed_grains_later(const TrajectoryReader& run, std::size_t frame,
+                                            const Frame& f) {
+  const PointIndex located(finite_rows(f.position));
+  std::vector<bool> decided(std::size_t(f.position.rows()));
+  for (Eigen::Index i = 0; i < f.position.rows(); ++i)
+    decided[std::size_t(i)] = f.position.row(i).allFinite();
+  std::vector<LaterGrain> later;
+  PointIndex::Hits nearest;
+  for (std::size_t t = frame + 1; t < run.frame_count(); ++t) {
+    const Frame next = run.read_frame(t);
     for (Eigen::Index i = 0; i < f.position.rows(); ++i) {
-      if (f.position.row(i).allFinite() || taken[std::size_t(i)]) continue;
-      if (!later.position.row(i).allFinite()) continue;
-      taken[std::size_t(i)] = true;  // its first later frame decides
-      placed.within(later.position.row(i).transpose(), reach, near);
-      if (!near.empty()) continue;
-      f.position.row(i) = later.position.row(i);
-      if (f.orientation.rows() > i) f.orientation.row(i) = later.orientation.row(i);
-      if (f.axis.rows() > i) f.axis.row(i) = later.axis.row(i);
+      if (decided[std::size_t(i)] || !next.position.row(i).allFinite()) continue;
+      decided[std::size_t(i)] = true;  // its first later frame decides
+      located.nearest(next.position.row(i).transpose(), 1, nearest);
+      later.push_back(
+          later_grain(next, i, nearest.empty() ? INFINITY : std::sqrt(nearest[0].second)));
     }
+    if (std::all_of(decided.begin(), decided.end(), [](bool d) { return d; })) break;
+  }
+  return later;
+}
+
+// `frame`, with grains it misses taken (position, orientation, axis) from the first later
+// frame that has them, none within `reach` of a grain already placed there: two grains'
+// centres are a diameter apart, so it is that grain, whose track the linker broke across the
+// scans between (on tracked scans of cycles 0 and 20-30, 3 of 2,500 tracks, 0.43-0.70 d from
+// a placed grain). Where the packing's grain count is known, no more than the frame lacks,
+// the farthest from the frame's grains first: a grain the scan missed leaves a hole a
+// diameter wide, while a broken track lies where its grain moved to, which can be further
+// than `reach` when the scans are many cycles apart (one of 2,000 over cycles 0 to 30).
+Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double reach,
+                     std::optional<std::size_t> grains) {
+  Frame f = run.read_frame(frame);
+  std::vector<LaterGrain> later = missed_grains_later(run, frame, f);
+  std::sort(later.begin(), later.end(),
+            [](const LaterGrain& a, const LaterGrain& b) { return a.clearance > b.clearance; });
+  const std::size_t located = std::size_t(finite_rows(f.position).rows());
+  std::size_t room = grains ? *grains - std::min(*grains, located) : later.size();
+  std::vector<Eigen::Vector3d> taken;
+  for (const LaterGrain& g : later) {
+    if (room == 0 || g.clearance < reach) break;  // the rest lie nearer
+    const Eigen::Vector3d x = g.position.transpose();
+    if (std::any_of(taken.begin(), taken.end(),
+                    [&](const Eigen::Vector3d& y) { return (x - y).norm() < reach; }))
+      continue;
+    taken.push_back(x);
+    --room;
+    f.position.row(g.row) = g.position;
+    if (f.orientation.rows() > g.row) f.orientation.row(g.row) = g.orientation;
+    if (f.axis.rows() > g.row) f.axis.row(g.row) = g.axis;
   }
   return f;
 }
@@ -81,7 +123,9 @@ Grains grains_of_frame(const TrajectoryReader& run, std::size_t frame,
   }
   const double metres = metres_per(h.length_unit);
   const Eigen::Vector3d corner = h.box ? h.box->lower : Eigen::Vector3d::Zero();
-  const Frame f = filled_forward(run, frame, 1.5 * deposit.radius / metres);  // 0.75 d
+  const std::optional<std::size_t> count =
+      deposit.grains > 0 ? std::optional<std::size_t>(std::size_t(deposit.grains)) : std::nullopt;
+  const Frame f = filled_forward(run, frame, 1.5 * deposit.radius / metres, count);  // 0.75 d
   const Vectors3& x = f.position;
   Grains grains;
   for (Eigen::Index i = 0; i < x.rows(); ++i) {

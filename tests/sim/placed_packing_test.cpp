@@ -138,6 +138,45 @@ TEST_F(PlacedPacking, ATrackTheLinkerBrokeIsNotPlacedTwice) {
   }
 }
 
+TEST_F(PlacedPacking, NoMoreGrainsAreTakenFromLaterFramesThanTheFrameLacks) {
+  // Grain 11's track starts at frame 1, 0.9 d above the top grain (that grain moved further
+  // than a broken track's 0.75 d between scans many cycles apart); grain 7, which the scan
+  // of frame 0 missed, is at frame 1 where its neighbours leave it a hole. A packing of 299
+  // grains: frame 0 lacks one, grain 7, and takes only it (the farthest from the frame's
+  // grains); of 300: both; of 298 (frame 0 holds them all): none.
+  Trajectories t = read_trajectories(path("run.h5"));
+  Eigen::Index top = 0;
+  t.frames[0].position.col(2).maxCoeff(&top);
+  ASSERT_NE(top, 11);
+  ASSERT_NE(top, 7);
+  t.frames[0].position.row(7).setConstant(NAN);
+  t.frames[0].position.row(11).setConstant(NAN);
+  for (std::size_t k : {1, 2}) {
+    t.frames[k].position.row(11) =
+        t.frames[0].position.row(top) + Eigen::RowVector3d(0, 0, 1.8 * pour.radius);
+  }
+  write_trajectories(path("far.h5"), t);
+  const TrajectoryReader run(path("far.h5"));
+  auto ids = [&](std::int64_t grains) {
+    DepositOptions packing = pour;
+    packing.grains = grains;
+    std::vector<std::int64_t> id = grains_of_frame(run, 0, packing, physics).id;
+    std::sort(id.begin(), id.end());
+    return id;
+  };
+  auto has = [](const std::vector<std::int64_t>& id, std::int64_t one) {
+    return std::binary_search(id.begin(), id.end(), one);
+  };
+  const std::int64_t id7 = t.header.id[7], id11 = t.header.id[11];
+  const auto of299 = ids(299), of300 = ids(300), of298 = ids(298);
+  EXPECT_EQ(of299.size(), 299u);
+  EXPECT_TRUE(has(of299, id7));
+  EXPECT_FALSE(has(of299, id11));
+  EXPECT_EQ(of300.size(), 300u);
+  EXPECT_EQ(of298.size(), 298u);
+  EXPECT_FALSE(has(of298, id7));
+}
+
 TEST_F(PlacedPacking, EachReplicaIsJitteredByItsRmsAndStaysInTheBox) {
   const TrajectoryReader run(path("run.h5"));
   const Grains g = grains_of_frame(run, 0, pour, physics);

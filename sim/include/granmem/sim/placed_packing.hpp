@@ -20,7 +20,9 @@ namespace granmem {
 // Each grain at its position in the frame, in the container's frame (the run's box corner
 // at the origin) and in metres; a grain the frame misses at its position in the first later
 // frame that has it (tracked ids), and left out if none has, or if a grain already placed
-// lies within 0.75 d of it there (a track the linker broke between scans: that grain).
+// lies within 0.75 d of it there (a track the linker broke between scans: that grain); no
+// more of them than deposit.grains less the grains the frame has (a frame holding them all
+// takes none), the farthest from the frame's grains first.
 // Radii: the deposit's radius when it has no polydispersity (a scan's located radii carry
 // its blur's bias), else the run's radius where known. Orientations: the run's where it has
 // them, else turned so that the body's z axis (the cavity) is the frame's axis, else the

@@ -57,11 +57,10 @@ std::vector<LaterGrain> missed_grains_later(const TrajectoryReader& run, std::si
 // `frame`, with grains it misses taken (position, orientation, axis) from the first later
 // frame that has them, none within `reach` of a grain already placed there: two grains'
 // centres are a diameter apart, so it is that grain, whose track the linker broke across the
-// scans between (on tracked scans of cycles 0 and 20-30, 3 of 2,500 tracks, 0.43-0.70 d from
-// a placed grain). Where the packing's grain count is known, no more than the frame lacks,
-// the farthest from the frame's grains first: a grain the scan missed leaves a hole a
-// diameter wide, while a broken track lies where its grain moved to, which can be further
-// than `reach` when the scans are many cycles apart (one of 2,000 over cycles 0 to 30).
+// scans between. Where the packing's grain count is known, no more than the frame lacks, the
+// farthest from the frame's grains first: a grain the scan missed leaves a hole a diameter
+// wide, while a broken track lies where its grain moved to, often further than `reach`
+// (docs/CALIBRATION.md, "A broken track placed twice").
 Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double reach,
                      std::optional<std::size_t> grains) {
   Frame f = run.read_frame(frame);

@@ -114,14 +114,15 @@ def fit(x, seeds, values, target, systematic, degree):
     systematic_variance = weights @ np.diag(systematic2) @ weights * widened
     sigma, t = np.sqrt(variance), stats.t.ppf(0.975, trend.spare)
     none = np.zeros_like(systematic2)
-    ratios = [r ** 2 for r in held_out_ratios(x, seeds, values, degree, trend).values()]
+    held_out = held_out_ratios(x, seeds, values, degree, trend)
+    ratios = [r ** 2 for r in held_out.values()]
     cross_validated = np.sqrt(np.mean(ratios) * trend.variance(g, none)) if ratios else 0.0
     if ratios and cross_validated > np.sqrt(max(0.0, variance - systematic_variance)):
         sigma = np.hypot(cross_validated, np.sqrt(systematic_variance))
         t = stats.t.ppf(0.975, len(ratios))
     return {"mu_s": np.exp(g), "low": np.exp(g - t * sigma), "high": np.exp(g + t * sigma),
             "chi2": chi2, "sigma": sigma, "gls_sigma": np.sqrt(variance),
-            "cross_validated": cross_validated}
+            "cross_validated": cross_validated, "trend": trend, "held_out": held_out}
 
 
 def read(folder, without):
@@ -173,14 +174,12 @@ def calibration(folder, without, draws, bootstrap, rng):
     summary, (x, seeds, values, target, systematic, degree) = read(folder, without)
     f = fit(x, seeds, values, target, systematic, degree)
     truth = np.log(summary["mu_s_true"])
-    trend = Trend(x, values, degree)
+    trend, held = f["trend"], f["held_out"]
     design = design_seeds(summary, seeds)
-    held = held_out_ratios(x, seeds, values, degree, trend)
-    row = {"z_gls": np.log(f["mu_s"]) - truth, "z_interval": np.log(f["mu_s"]) - truth}
-    row["z_gls"] /= f["gls_sigma"]
-    row["z_interval"] /= f["sigma"]
-    row["held_out_design"] = [r for i, r in held.items() if design[i]]
-    row["held_out_refined"] = [r for i, r in held.items() if not design[i]]
+    error = np.log(f["mu_s"]) - truth
+    row = {"z_gls": error / f["gls_sigma"], "z_interval": error / f["sigma"],
+           "held_out_design": [r for i, r in held.items() if design[i]],
+           "held_out_refined": [r for i, r in held.items() if not design[i]]}
     null = {"z_gls": [], "held_out_design": [], "held_out_refined": []}
     deviations = residual_draws(x, values, trend, degree, bootstrap, rng)
     none = np.zeros(values.shape[1])

@@ -67,7 +67,7 @@ Frame filled_forward(const TrajectoryReader& run, std::size_t frame, double reac
   std::vector<LaterGrain> later = missed_grains_later(run, frame, f);
   std::sort(later.begin(), later.end(),
             [](const LaterGrain& a, const LaterGrain& b) { return a.clearance > b.clearance; });
-  const std::size_t located = std::size_t(finite_rows(f.position).rows());
+  const auto located = std::size_t(f.position.array().isFinite().rowwise().all().count());
   std::size_t room = grains ? *grains - std::min(*grains, located) : later.size();
   std::vector<Eigen::Vector3d> taken;
   for (const LaterGrain& g : later) {

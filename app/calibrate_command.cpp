@@ -34,7 +34,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                                preparation = "auto", summaries = "pooled",
                                                observables = "steady-state", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
-    bool subtract_drift = true, fit_only = false;
+    bool subtract_drift = true, fit_only = false, one_cycle_ahead = false;
     int threads = 0, degree = 0, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto", placed_cycle = "auto";
     std::string true_mu_s, true_mu_r;
@@ -154,6 +154,12 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_flag("--fit-only", args->fit_only,
                 "steady-state: fit and stop; no run at the fitted friction, so no distances "
                 "or comparison figures (one simulation fewer)");
+  cmd->add_flag("--one-cycle-ahead", args->one_cycle_ahead,
+                "steady-state, placed twin, mu_s: after the design's fit, one packing more at "
+                "fit/1.2, fit/1.07, fit x 1.07 and fit x 1.2, placed anew from the experiment's "
+                "frame of every cycle before one of the window and driven that one cycle; the fit "
+                "the mean of the cycles' own, its error their scatter (no refined packings, no "
+                "comparison run; docs/CALIBRATION.md, \"One cycle ahead\")");
   cmd->add_option("--threads", args->threads,
                   "runs at once, and the cores they use (default: one per core; the last run also "
                   "takes the cores the others leave)");
@@ -203,6 +209,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
     o.placed_cycle = parse_placed_cycle(args->placed_cycle, "--placed-cycle");
     o.fit_only = args->fit_only;
+    o.one_cycle_ahead = args->one_cycle_ahead;
     if (!args->true_mu_s.empty()) o.true_mu_s = one_friction(args->true_mu_s, "--true-mu-s");
     if (!args->true_mu_r.empty()) o.true_mu_r = one_friction(args->true_mu_r, "--true-mu-r");
     o.parallel = args->threads;

@@ -17,7 +17,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 read -r -a render <<< "${RENDER:-}"
 out=$(realpath -m "$1") protocol=$(realpath "$2")
 shift 2
-granmem=$root/build/app/granmem
+granmem=${GRANMEM:-$root/build/app/granmem}
 window=$(sed -n 's/^window *= *"\(.*\)".*/\1/p' "$protocol")
 first=${window%:*} last=${window#*:}
 frames="0 $(seq $((first > 1 ? first - 1 : 1)) "$last")"

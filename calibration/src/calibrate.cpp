@@ -1557,6 +1557,19 @@ std::vector<FrictionRunSpec> refined_design(Twin& twin, std::vector<FrictionRunS
   return specs;
 }
 
+// summary.json's head for a fit of mu_s: the fit, its interval (s.mu_s_ci95), the truth,
+// how the interval was made and the standard error of ln mu_s behind it.
+JsonObject fitted_mu_s_json(double mu_s, const std::string& method, double log_mu_s_sigma,
+                            const CalibrateSummary& s) {
+  JsonObject j;
+  j["mu_s"] = mu_s;
+  j["mu_s_ci95"] = s.mu_s_ci95;
+  j["mu_s_true"] = s.true_mu_s;
+  j["mu_s_interval_method"] = method;
+  j["log_mu_s_sigma"] = log_mu_s_sigma;
+  return j;
+}
+
 void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& specs,
                       CalibrateSummary& s, std::ostream& report) {
   const CalibrateOptions& o = twin.options();
@@ -1579,12 +1592,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
   const SteadyStateOutputs written =
       write_steady_state_fit(o.out, fit, measured, runs, s.true_mu_s, twin.observe.window);
   s.written.insert(s.written.end(), written.written.begin(), written.written.end());
-  JsonObject j;
-  j["mu_s"] = fit.mu_s;
-  j["mu_s_ci95"] = s.mu_s_ci95;
-  j["mu_s_true"] = s.true_mu_s;
-  j["mu_s_interval_method"] = fit.method;
-  j["log_mu_s_sigma"] = fit.log_mu_s_sigma;
+  JsonObject j = fitted_mu_s_json(fit.mu_s, fit.method, fit.log_mu_s_sigma, s);
   j["gls_sigma"] = fit.gls_sigma;
   j["systematic_sigma"] = fit.systematic_sigma;
   j["cross_validated_sigma"] = fit.cross_validated_sigma;
@@ -1630,6 +1638,158 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
     report << "  note: " << note << "\n";
   report << "wrote " << (o.out / "summary.json").string() << ", steady_state_runs.csv, "
          << written.written.size() - 1 + compared.written.size() << " figure files\n";
+}
+
+// One cycle ahead (CalibrateOptions::one_cycle_ahead): the experiment's cycles each a
+// segment, its frame before it the twin's start, its own frame the compared.
+std::vector<std::int64_t> ahead_cycles(const Twin& twin) {
+  const auto [first, last] = twin.observe.window;
+  if (last - first + 1 < 3) {
+    throw Error(
+        "--one-cycle-ahead: a window of at least 3 cycles (their scatter is the fit's "
+        "error); this one has " +
+        std::to_string(last - first + 1));
+  }
+  std::vector<std::int64_t> cycles;
+  for (std::int64_t c = first; c <= last; ++c) {
+    for (std::int64_t f : {c - 1, c}) {
+      if (!frame_of_cycle(twin.experiment(), f)) {
+        throw Error("--one-cycle-ahead: " + twin.options().experiment.string() +
+                    " has no frame of cycle " + std::to_string(f) +
+                    " (every cycle of the window and the one before it are needed)");
+      }
+    }
+    cycles.push_back(c);
+  }
+  return cycles;
+}
+
+// A segment's trend in ln mu_s across the ahead packing's four frictions (kOneCycleAheadSpan).
+constexpr int kOneCycleAheadDegree = 2;
+
+// A segment's options: the ahead packing (`mu`, its own seed) placed from cycle - 1 and
+// compared over that cycle alone, in its own folder.
+CalibrateOptions segment_options(const CalibrateOptions& o, std::int64_t cycle,
+                                 const std::vector<double>& mu, std::uint64_t seed) {
+  CalibrateOptions s = o;
+  s.one_cycle_ahead = false;
+  s.placed_cycle = cycle - 1;
+  s.window = std::pair{cycle, cycle};
+  s.out = o.out / "ahead" / ("cycle_" + std::to_string(cycle));
+  s.mu_s = mu;
+  s.replicas = 1;
+  s.refine = 0;
+  s.degree = kOneCycleAheadDegree;
+  s.fit_only = true;
+  s.twin["seed"] = std::to_string(seed);
+  return s;
+}
+
+// One segment's experiment and runs as the scans see them (fit_as_scanned: the runs given
+// the scans' error, the placed read-back as the experiment's systematic errors) and the
+// observables its fit keeps.
+SteadyStateSegment ahead_segment(const CalibrateOptions& so, const Twin& twin,
+                                 std::vector<std::string>& kept) {
+  fs::create_directories(so.out / "runs");
+  Twin segment(so, twin.experiment());
+  const std::vector<FrictionRunSpec> specs = segment.design();
+  segment.run(specs);
+  ScanNoise noise;
+  SteadyStateSegment seg;
+  const ObservableFit own = steady_state_fit(segment, specs, seg.runs, &noise);
+  seg.experiment = noise.experiment;
+  kept = own.names;
+  return seg;
+}
+
+std::vector<std::string> in_both(const std::vector<std::string>& a,
+                                 const std::vector<std::string>& b) {
+  std::vector<std::string> both;
+  for (const std::string& n : a)
+    if (std::find(b.begin(), b.end(), n) != b.end()) both.push_back(n);
+  return both;
+}
+
+// `edge`: design_edge_note() of the packing ahead (empty where the fit is inside its range).
+void report_one_cycle_ahead(const Twin& twin, const SegmentedFit& fit,
+                            const std::vector<std::int64_t>& cycles, const CalibrateSummary& s,
+                            const std::string& edge, std::ostream& report) {
+  report << std::setprecision(3) << "mu_s = " << fit.mu_s << "  (95% interval " << fit.mu_s_ci95[0]
+         << " - " << fit.mu_s_ci95[1] << ", " << s.simulations << " simulations, one cycle ahead)";
+  if (std::isfinite(s.true_mu_s)) report << "  true " << s.true_mu_s;
+  report << "\n  " << cycles.size() << " cycles' own fits (cycle: mu_s):";
+  for (std::size_t k = 0; k < cycles.size(); ++k)
+    report << " " << cycles[k] << ": " << fit.segment_mu_s[k];
+  report << "\n  on";
+  for (const std::string& n : fit.names)
+    report << " " << n;
+  report << "; +-" << fit.scatter_sigma << " in ln mu_s from the cycles' scatter, "
+         << fit.systematic_sigma << " from the experiment's systematic errors\n";
+  if (!edge.empty()) report << "  note: " << edge << "\n";
+  report << "wrote " << (twin.options().out / "summary.json").string() << "\n";
+}
+
+void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
+                                   const std::vector<std::int64_t>& cycles,
+                                   const std::vector<double>& mu, const std::string& design_line,
+                                   const CalibrateSummary& s) {
+  JsonObject j = fitted_mu_s_json(fit.mu_s, fit.method, fit.log_mu_s_sigma, s);
+  j["scatter_sigma"] = fit.scatter_sigma;
+  j["systematic_sigma"] = fit.systematic_sigma;
+  j["one_cycle_ahead"] = true;
+  j["cycles"] = cycles;
+  j["cycle_mu_s"] = fit.segment_mu_s;
+  j["ahead_mu_s"] = mu;
+  j["observables"] = fit.names;
+  j["design_fit"] = design_line;
+  j["n_simulations"] = s.simulations;
+  j["deposit"] = preparation_name(twin.options().preparation);
+  add_protocol(j, twin);
+  write_json(twin.options().out / "summary.json", j);
+}
+
+// The design's fit, then its packing one cycle ahead over every cycle of the window, and
+// the fit of the segments.
+void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& design,
+                         CalibrateSummary& s, std::ostream& report) {
+  const CalibrateOptions& o = twin.options();
+  const std::vector<std::int64_t> cycles = ahead_cycles(twin);
+  DesignFit first = design_fit(twin, design);
+  std::vector<double> mu;
+  for (double f : kOneCycleAheadSpan)
+    mu.push_back(three_digits(first.at.mu_s * f));
+  const std::uint64_t seed = twin.next_seed(0);
+  std::vector<FrictionRunSpec> ahead;
+  for (double m : mu)
+    ahead.push_back({m, seed});
+  first.line += "one cycle ahead: a packing more (seed " + std::to_string(seed) + ") at mu_s " +
+                refined_frictions_text(ahead) +
+                ", placed anew from the experiment's frame of each of cycles " +
+                std::to_string(cycles.front() - 1) + "-" + std::to_string(cycles.back() - 1) +
+                " and driven the next";
+  twin.say(first.line);
+  report << first.line << "\n";
+  std::vector<SteadyStateSegment> segments;
+  std::vector<std::string> names = o.only;
+  for (std::int64_t c : cycles) {
+    twin.say("cycle " + std::to_string(c) + ": placed from the experiment's frame of cycle " +
+             std::to_string(c - 1));
+    const CalibrateOptions so = segment_options(o, c, mu, seed);
+    std::vector<std::string> kept;
+    segments.push_back(ahead_segment(so, twin, kept));
+    names = names.empty() && c == cycles.front() ? kept : in_both(names, kept);
+  }
+  ObservableFitOptions by_cycle = observable_fit_options(twin);
+  by_cycle.degree = kOneCycleAheadDegree;
+  const SegmentedFit fit = fit_friction_by_segments(segments, by_cycle, names);
+  if (!mpi_ranks().root()) return;
+  s.mu_s = fit.mu_s;
+  s.mu_s_ci95 = {fit.mu_s_ci95[0], fit.mu_s_ci95[1]};
+  s.simulations = s.simulations_fitted = design.size() + mu.size();
+  write_one_cycle_ahead_summary(twin, fit, cycles, mu, first.line, s);
+  s.written.push_back(o.out / "summary.json");
+  report_one_cycle_ahead(twin, fit, cycles, s, design_edge_note(fit.mu_s, segments.front().runs),
+                         report);
 }
 
 void fit_joint(const Twin& twin, const std::vector<FrictionRunSpec>& specs, CalibrateSummary& s,
@@ -1878,8 +2038,9 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
                         : steady ? Design{{0.05, 0.14, 0.4}, 3, 3}
                                  : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
-  // A design given is run as given: refined only where asked.
-  if (!o.refine) o.refine = o.mu_s.empty() && o.replicas == 0 ? design.refine : 0;
+  // A design given is run as given: refined only where asked (one cycle ahead: never).
+  if (!o.refine)
+    o.refine = o.mu_s.empty() && o.replicas == 0 && !one_cycle_ahead ? design.refine : 0;
   if (o.mu_s.empty()) o.mu_s = design.mu_s;
   if (o.replicas == 0) o.replicas = design.replicas;
   return o;
@@ -1919,6 +2080,18 @@ void CalibrateOptions::validate() const {
   // Replicas of a placed packing differ by their jitter alone: none, and they are one run.
   if (!std::isnan(placed_jitter) && !(placed_jitter > 0 && std::isfinite(placed_jitter))) {
     throw Error("--placed-jitter: a length > 0 (replicas not moved would all be the same run)");
+  }
+  if (one_cycle_ahead) {
+    if (!steady || joint() || preparation != TwinPreparation::experiment) {
+      throw Error(
+          "--one-cycle-ahead: only for a steady-state fit of mu_s on a twin placed from the "
+          "experiment's packing (--deposit experiment, or auto on a simulation or fine scans)");
+    }
+    if (refined_packings() > 0 || auto_window || placed_cycle) {
+      throw Error(
+          "--one-cycle-ahead: not with --refine, --window auto or --placed-cycle (its packing "
+          "is placed from every cycle's frame, after the design's fit)");
+    }
   }
   if (placed_cycle && *placed_cycle < 0) throw Error("--placed-cycle: a cycle, 0 or later");
   if (placed_cycle && auto_window) {
@@ -1981,6 +2154,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   s.true_mu_r = true_friction(experiment.header(), "mu-r", options.true_mu_r);
   const bool steady = options.observables == CalibrationObservables::steady_state;
   if (steady) check_only(options, twin.measured_steady_state());
+  if (options.one_cycle_ahead) ahead_cycles(twin);  // refused before any run
   std::string noise_model;
   const FrictionFitOptions fit_options =
       steady ? FrictionFitOptions{}
@@ -1994,7 +2168,9 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   std::ostringstream report;
   if (options.auto_window) report << twin.choose_window(specs) << "\n";
   if (options.refined_packings() > 0) specs = refined_design(twin, std::move(specs), report);
-  if (options.joint()) {
+  if (options.one_cycle_ahead) {
+    fit_one_cycle_ahead(twin, specs, s, report);
+  } else if (options.joint()) {
     fit_joint(twin, specs, s, report);
   } else if (steady) {
     fit_steady_state(twin, specs, s, report);

@@ -42,7 +42,8 @@ struct Trend {
   Eigen::MatrixXd coefficients;    // terms x observables
   Eigen::MatrixXd normal_inverse;  // (X^T X)^-1
   Eigen::MatrixXd covariance;      // observables x observables
-  Eigen::VectorXd scatter;         // its diagonal's square roots, before shrinking
+  Eigen::MatrixXd sample;          // the runs' covariance about the trend, before shrinking
+  Eigen::VectorXd scatter;         // its diagonal's square roots
   double spare = 0;                // runs - terms
 
   Eigen::RowVectorXd powers(const LogFriction& x) const {
@@ -79,6 +80,17 @@ struct Trend {
   }
 };
 
+// Few spare runs estimate m variances well enough but m(m-1)/2 correlations poorly: the
+// fewer the runs, the more the estimate is shrunk towards its diagonal.
+Eigen::MatrixXd shrunk_covariance(const Eigen::MatrixXd& sample, double spare) {
+  const double m = double(sample.rows());
+  const double shrink = m / (m + spare);
+  Eigen::MatrixXd c = (1 - shrink) * sample;
+  c.diagonal() = sample.diagonal();
+  c.diagonal().array() += 1e-12 * sample.diagonal().maxCoeff() + 1e-300;
+  return c;
+}
+
 Trend fit_trend(const std::vector<ObservableRun>& runs, int dims, int degree) {
   Trend t;
   t.terms = polynomial_terms(dims, degree);
@@ -95,14 +107,9 @@ Trend fit_trend(const std::vector<ObservableRun>& runs, int dims, int degree) {
   t.coefficients = t.normal_inverse * x.transpose() * y;
   t.spare = double(k) - double(t.terms.size());
   const Eigen::MatrixXd residual = y - x * t.coefficients;
-  const Eigen::MatrixXd sample = residual.transpose() * residual / t.spare;
-  t.scatter = sample.diagonal().cwiseSqrt();
-  // Few spare runs estimate m variances well enough but m(m-1)/2 correlations poorly: the
-  // fewer the runs, the more the estimate is shrunk towards its diagonal.
-  const double shrink = double(m) / (double(m) + t.spare);
-  t.covariance = (1 - shrink) * sample;
-  t.covariance.diagonal() = sample.diagonal();
-  t.covariance.diagonal().array() += 1e-12 * sample.diagonal().maxCoeff() + 1e-300;
+  t.sample = residual.transpose() * residual / t.spare;
+  t.scatter = t.sample.diagonal().cwiseSqrt();
+  t.covariance = shrunk_covariance(t.sample, t.spare);
   return t;
 }
 
@@ -179,10 +186,11 @@ std::pair<LogFriction, LogFriction> bounds(const std::vector<ObservableRun>& run
   return {lo, hi};
 }
 
-OneFit fit_once(const Target& target, const std::vector<ObservableRun>& runs, int dims,
-                int degree) {
+// The GLS fit against a trend already through the runs.
+OneFit fit_to_trend(const Target& target, const std::vector<ObservableRun>& runs, int dims,
+                    Trend trend) {
   OneFit f;
-  f.trend = fit_trend(runs, dims, degree);
+  f.trend = std::move(trend);
   const auto [lo, hi] = bounds(runs, dims);
   // Start from the best of a grid: the misfit need not be convex across the range.
   const int n = dims == 1 ? 48 : 16;
@@ -226,6 +234,11 @@ OneFit fit_once(const Target& target, const std::vector<ObservableRun>& runs, in
     if (round == 1) f.covariance = parameter_covariance(problem, blocks);
   }
   return f;
+}
+
+OneFit fit_once(const Target& target, const std::vector<ObservableRun>& runs, int dims,
+                int degree) {
+  return fit_to_trend(target, runs, dims, fit_trend(runs, dims, degree));
 }
 
 void check_runs(const std::vector<double>& experiment, const std::vector<ObservableRun>& runs,
@@ -552,6 +565,111 @@ JointObservableFit fit_frictions_to_steady_state(const SteadyState& experiment,
                      [](const auto& measured, const auto& twin, const auto& with) {
                        return fit_frictions_to_observables(measured, twin, with);
                      });
+}
+
+namespace {
+
+// The observables common_observables() picks in every segment, in the first one's order.
+std::vector<std::string> observables_of_every_segment(
+    const std::vector<SteadyStateSegment>& segments, const std::vector<std::string>& only) {
+  std::vector<std::string> names;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    std::vector<double> measured;
+    std::vector<ObservableRun> twin;
+    const std::vector<std::string> here =
+        common_observables(segments[k].experiment, segments[k].runs, only, measured, twin);
+    if (k == 0) {
+      names = here;
+      continue;
+    }
+    names.erase(std::remove_if(names.begin(), names.end(),
+                               [&](const std::string& n) {
+                                 return std::find(here.begin(), here.end(), n) == here.end();
+                               }),
+                names.end());
+  }
+  if (names.empty()) throw Error("segmented fit: no observable in every segment");
+  return names;
+}
+
+// One segment as the fit takes it: its target, its runs and their trend.
+struct Segment {
+  Target target;
+  std::vector<ObservableRun> runs;
+  Trend trend;
+};
+Segment prepared_segment(const SteadyStateSegment& s, const std::vector<std::string>& names,
+                         const ObservableFitOptions& options) {
+  Segment p;
+  std::vector<double> measured;
+  common_observables(s.experiment, s.runs, names, measured, p.runs);
+  ObservableFitOptions with = options;
+  with.experiment_systematic.clear();
+  for (const std::string& name : names)
+    with.experiment_systematic.push_back(s.experiment.systematic_of(name));
+  check_runs(measured, p.runs, 1, with);
+  const Eigen::Index n = Eigen::Index(names.size());
+  p.target.value = Eigen::Map<const Eigen::VectorXd>(measured.data(), n);
+  p.target.systematic =
+      Eigen::Map<const Eigen::VectorXd>(with.experiment_systematic.data(), n).array().square();
+  p.trend = fit_trend(p.runs, 1, options.degree);
+  return p;
+}
+
+}  // namespace
+
+SegmentedFit fit_friction_by_segments(const std::vector<SteadyStateSegment>& segments,
+                                      const ObservableFitOptions& options,
+                                      const std::vector<std::string>& only) {
+  if (segments.size() < 3) {
+    throw Error("segmented fit: " + std::to_string(segments.size()) +
+                " segments, need at least 3 (their scatter is the fit's error)");
+  }
+  SegmentedFit fit;
+  fit.names = observables_of_every_segment(segments, only);
+  std::vector<Segment> prepared;
+  for (const SteadyStateSegment& s : segments)
+    prepared.push_back(prepared_segment(s, fit.names, options));
+  // One cycle's scatter about the trend, pooled over the segments' spare runs.
+  Eigen::MatrixXd pooled =
+      Eigen::MatrixXd::Zero(prepared[0].trend.sample.rows(), prepared[0].trend.sample.cols());
+  double spare = 0;
+  for (const Segment& p : prepared) {
+    pooled += p.trend.sample * p.trend.spare;
+    spare += p.trend.spare;
+  }
+  pooled /= spare;
+  const Eigen::MatrixXd covariance = shrunk_covariance(pooled, spare);
+  double sum = 0, systematic = 0;
+  for (Segment& p : prepared) {
+    p.trend.covariance = covariance;
+    const OneFit f = fit_to_trend(p.target, p.runs, 1, p.trend);
+    fit.segment_mu_s.push_back(std::exp(f.x(0)));
+    sum += f.x(0);
+    systematic += std::sqrt(systematic_share(f.trend, f.x, p.target.systematic)(0, 0));
+  }
+  const double n = double(segments.size()), mean = sum / n;
+  double spread2 = 0;
+  for (double mu : fit.segment_mu_s)
+    spread2 += std::pow(std::log(mu) - mean, 2) / (n - 1);
+  fit.scatter_sigma = std::sqrt(spread2 / n);
+  fit.systematic_sigma = systematic / n;
+  fit.log_mu_s_sigma = std::hypot(fit.scatter_sigma, fit.systematic_sigma);
+  const double t = student_t_975(n - 1);
+  fit.mu_s = std::exp(mean);
+  fit.mu_s_ci95 = {std::exp(mean - t * fit.log_mu_s_sigma),
+                   std::exp(mean + t * fit.log_mu_s_sigma)};
+  for (Eigen::Index o = 0; o < pooled.rows(); ++o)
+    fit.scatter.push_back(std::sqrt(pooled(o, o)));
+  fit.runs = prepared[0].runs.size();
+  fit.method = "the mean of " + std::to_string(segments.size()) + " segments' Ceres GLS fits of " +
+               std::to_string(fit.names.size()) + " one-cycle observables against their trend in " +
+               "ln mu_s (degree " + std::to_string(options.degree) + ") across " +
+               std::to_string(fit.runs) + " runs each, covariance pooled over the segments (" +
+               std::to_string(int(spare)) + " spare runs, shrunk to its diagonal); its error " +
+               "the segments' scatter, Student's t for " + std::to_string(segments.size() - 1) +
+               " dof";
+  return fit;
 }
 
 }  // namespace granmem

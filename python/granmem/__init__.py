@@ -327,8 +327,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="steady-state", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=0, replicas=None,
               refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto",
-              placed_cycle="auto", fit_only=False, true_mu_s=None, true_mu_r=None, parallel=0,
-              progress=None, **twin):
+              placed_cycle="auto", fit_only=False, one_cycle_ahead=False, true_mu_s=None,
+              true_mu_r=None, parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -356,7 +356,11 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     where it holds the packing, and drives the cycles after it;
     each replica moved by ``placed_jitter``, a length; "auto": 1e-4 grain diameters) or "auto"
     (the default: "experiment" for a steady-state fit of mu_s on a simulation's packing,
-    whose frame there holds it exactly, else "each").
+    whose frame there holds it exactly, else "each"). ``one_cycle_ahead`` (steady-state, a
+    placed twin, mu_s): after the design's fit, one packing more at fit / 1.2, / 1.07, x 1.07
+    and x 1.2, placed anew from the experiment's frame of every cycle before one of the window
+    and driven that one cycle; the fit the mean of the cycles' own, its error their scatter
+    (no refined packings, no comparison run; docs/CALIBRATION.md, "One cycle ahead").
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
     "steady-state" 0.05, 0.14, 0.4 on 3 packings, then 3 more at their fit (12 runs; a twin
@@ -383,5 +387,6 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                               "auto" if axis_noise is None else axis_noise if isinstance(
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
-                              "auto" if placed_cycle is None else str(placed_cycle), bool(fit_only), _optional_float(true_mu_s),
+                              "auto" if placed_cycle is None else str(placed_cycle), bool(fit_only),
+                              bool(one_cycle_ahead), _optional_float(true_mu_s),
                               _optional_float(true_mu_r), int(parallel), twin, progress)

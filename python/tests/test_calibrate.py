@@ -208,6 +208,18 @@ def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):
         tmp_path / "scans30.h5", tmp_path / "cal30", **FIT, **TWIN)["report"]
 
 
+def test_one_cycle_ahead_is_the_command_lines(tmp_path, cli, experiment):
+    ahead = dict(FIT, mu_s=[0.1, 0.2, 0.4], window=(1, 3), fit_only=False, one_cycle_ahead=True)
+    fit = granmem.calibrate(experiment, tmp_path / "py", **ahead, **TWIN)
+    assert fit["simulations"] == 10  # 3 frictions x 2 packings, and the packing ahead at 4
+    lo, hi = fit["mu_s_ci95"]
+    assert lo <= 0.2 <= hi
+    out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.1,0.2,0.4",
+              "--window", "1:3", "--one-cycle-ahead", *TWIN_FLAGS)
+    assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
+    assert "3 cycles' own fits" in out
+
+
 def test_a_stopped_calibration_reuses_its_finished_runs(tmp_path, experiment):
     def stop_at_first_report(report):
         if "cycle" in report:

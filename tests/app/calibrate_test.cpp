@@ -518,6 +518,52 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
 // carried as the experiment's systematic error (each observable's at least the probe's), and
 // a second call reuses it; a simulation's exact frame needs no probe, nor scans placed from
 // their preparation, which the drive has not trained.
+// --one-cycle-ahead: after the design's fit, one packing more at four frictions about it,
+// placed anew from the experiment's frame before each cycle of the window and driven that
+// cycle; the fit is the mean of the cycles' own, and holds the truth.
+TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
+  const std::vector<std::string> design{"--window", "1:3", "--mu-s", "0.1,0.2,0.4",
+                                        "--one-cycle-ahead"};
+  const RunResult r = granmem_ok(calibrate(design));
+  EXPECT_NE(r.out.find("one cycle ahead: a packing more (seed 3) at mu_s "), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("3 cycles' own fits (cycle: mu_s): 1: "), std::string::npos) << r.out;
+  const std::string json = read_text(in_work("cal/summary.json"));
+  const auto [lo, hi] = expect_fit_in_its_interval(json);
+  EXPECT_LE(lo, 0.2) << json;
+  EXPECT_GE(hi, 0.2) << json;
+  EXPECT_EQ(json_value(json, "n_simulations"), 6 + 4) << json;
+  EXPECT_NE(json.find("\"one_cycle_ahead\": true"), std::string::npos) << json;
+  // Each cycle's runs start from the experiment's frame before it, and drive that cycle only.
+  for (std::int64_t c = 1; c <= 3; ++c) {
+    const std::filesystem::path runs = in_work("cal/ahead/cycle_" + std::to_string(c) + "/runs");
+    int found = 0;
+    for (const auto& e : std::filesystem::directory_iterator(runs)) {
+      if (e.path().extension() != ".h5") continue;
+      ++found;
+      const TrajectoryReader run(e.path().string());
+      EXPECT_EQ(run.steps().front(), c - 1) << e.path();
+      EXPECT_EQ(run.steps().back(), c) << e.path();
+      EXPECT_NE(e.path().filename().string().find("_seed_3.h5"), std::string::npos) << e.path();
+    }
+    EXPECT_EQ(found, 4) << runs;
+  }
+  // A second call reuses every run.
+  const RunResult again = granmem_ok(calibrate(design));
+  EXPECT_EQ(again.err.find(" runs, "), std::string::npos) << again.err;
+  EXPECT_EQ(read_text(in_work("cal/summary.json")), json);
+  // Refused before any run: too short a window, a refined design, a joint fit, a poured twin.
+  std::vector<std::string> bad =
+      calibrate({"--window", "2:3", "--mu-s", "0.1,0.2,0.4", "--one-cycle-ahead"});
+  expect_clean_failure(bad, {"--one-cycle-ahead", "at least 3 cycles"});
+  bad = calibrate(design);
+  bad.insert(bad.end(), {"--refine", "2"});
+  expect_clean_failure(bad, {"--one-cycle-ahead", "not with --refine"});
+  bad = calibrate(design);
+  bad.insert(bad.end(), {"--deposit", "each"});
+  expect_clean_failure(bad, {"--one-cycle-ahead", "placed from the experiment's packing"});
+}
+
 TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {
   Trajectories scans = read_trajectories(in_work("exp.h5"));
   scans.header.has_position_error = true;

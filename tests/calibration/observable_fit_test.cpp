@@ -546,6 +546,82 @@ TEST(ObservableFit, TheJointFitOfMuSAndMuRHoldsBothAtTheirRate) {
   EXPECT_LT(std::sqrt(error_r), 0.35);
 }
 
+// One cycle ahead: each segment (a cycle the twin is placed into anew) moves the
+// experiment and the twin's runs alike by that cycle's own state, each run by its own noise
+// and the experiment by its one-cycle chaos, twice the runs' noise (what the twin's jittered
+// replicas do not see). Observables like the wall force, the lid's packing fraction and the
+// rotation, their one-cycle noise ~0.01 in ln mu_s each.
+struct SyntheticSegments {
+  std::mt19937_64 random;
+  std::normal_distribution<double> normal{0, 1};
+  std::vector<double> values(double mu, const std::vector<double>& cycle, double noise) {
+    const double x = std::log(mu);
+    return {0.55 - 0.015 * x - 0.002 * x * x + cycle[0] + noise * 1.5e-4 * normal(random),
+            7.5 + 2.0 * x + cycle[1] + noise * 0.02 * normal(random),
+            0.016 + 0.003 * x + cycle[2] + noise * 3e-5 * normal(random)};
+  }
+  static SteadyState state(std::vector<double> v) {
+    SteadyState st;
+    st.names = {"a", "b", "c"};
+    st.values = std::move(v);
+    return st;
+  }
+  // Four runs about a first fit off the truth by ~5 %, at the design's / 1.2 ... x 1.2.
+  std::vector<SteadyStateSegment> draw(double truth, int segments) {
+    const double centre = truth * std::exp(0.05 * normal(random));
+    std::vector<SteadyStateSegment> out;
+    for (int c = 0; c < segments; ++c) {
+      const std::vector<double> cycle{0.002 * normal(random), 0.3 * normal(random),
+                                      0.0005 * normal(random)};
+      SteadyStateSegment seg;
+      seg.experiment = state(values(truth, cycle, 2.0));
+      std::uint64_t seed = 3;
+      for (double f : {1 / 1.2, 1 / 1.07, 1.07, 1.2})
+        seg.runs.push_back({centre * f, seed++, state(values(centre * f, cycle, 1.0))});
+      out.push_back(std::move(seg));
+    }
+    return out;
+  }
+  double log_uniform(double lo, double hi) {
+    return std::exp(std::log(lo) + std::log(hi / lo) * std::uniform_real_distribution<>()(random));
+  }
+};
+
+TEST(ObservableFit, OneCycleAheadSegmentsHoldTheTruthAtTheirRate) {
+  SyntheticSegments g{std::mt19937_64(42)};
+  int held = 0;
+  double error2 = 0;
+  const int trials = 400;
+  for (int trial = 0; trial < trials; ++trial) {
+    const double truth = g.log_uniform(0.1, 0.5);
+    const SegmentedFit fit = fit_friction_by_segments(g.draw(truth, 10));
+    held += fit.mu_s_ci95[0] <= truth && truth <= fit.mu_s_ci95[1];
+    error2 += std::pow(std::log(fit.mu_s / truth) / fit.log_mu_s_sigma, 2);
+    ASSERT_EQ(fit.segment_mu_s.size(), 10u);
+    ASSERT_EQ(fit.runs, 4u);
+  }
+  const double z_rms = std::sqrt(error2 / trials);
+  std::printf("one cycle ahead: coverage %.3f, error over sigma RMS %.2f\n", double(held) / trials,
+              z_rms);
+  EXPECT_GE(held, int(0.90 * trials));
+  EXPECT_LE(held, int(0.99 * trials));
+  // The error is what the sigma says (Student's t for 9 dof makes the mean's z RMS ~1.13).
+  EXPECT_GT(z_rms, 0.8);
+  EXPECT_LT(z_rms, 1.4);
+}
+
+TEST(ObservableFit, OneCycleAheadNeedsThreeSegmentsAndTheSameObservables) {
+  SyntheticSegments g{std::mt19937_64(5)};
+  std::vector<SteadyStateSegment> segments = g.draw(0.3, 2);
+  EXPECT_THROW(fit_friction_by_segments(segments), Error);
+  segments = g.draw(0.3, 4);
+  // An observable one segment lacks is left out of every segment's fit.
+  segments[1].experiment.values[2] = std::nan("");
+  const SegmentedFit fit = fit_friction_by_segments(segments);
+  EXPECT_EQ(fit.names, (std::vector<std::string>{"a", "b"}));
+  EXPECT_THROW(fit_friction_by_segments(segments, {}, {"c"}), Error);
+}
+
 TEST(ObservableFit, TooFewRunsOrMismatchedObservablesAreRefused) {
   const std::vector<ObservableRun> three{{0.1, 1, {1, 2}}, {0.2, 1, {2, 3}}, {0.3, 1, {3, 4}}};
   EXPECT_THROW(fit_friction_to_observables({1.5, 2.5}, three), Error);

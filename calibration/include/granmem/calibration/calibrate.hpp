@@ -46,6 +46,11 @@ inline constexpr const char* kProtocolSettings[] = {
 // lid are ~1e-3 d; moved by 1e-2 d, a 2,500-grain packing settled 1 % denser, by 1e-4 d as
 // it was), and the runs' chaos grows it to a replica's scatter within cycles.
 inline constexpr double kPlacedJitterDiameters = 1e-4;
+// CalibrateOptions::one_cycle_ahead: the frictions of its packing, times the design's fit:
+// on both sides, within where the one-cycle observables' trend is a quadratic in ln mu_s
+// (the end-of-cycle displacement bends most, and a line through +-15 % read it 7 % high at
+// 0.46), and wide enough to hold the truth where the design's fit is off by 10 %.
+inline constexpr double kOneCycleAheadSpan[] = {1 / 1.2, 1 / 1.07, 1.07, 1.2};
 // The preparation's name in options, the summary and the runs' parameters.
 const char* preparation_name(TwinPreparation preparation);
 // Its name read back (each, shared, experiment, auto); Error naming `option` otherwise.
@@ -125,6 +130,16 @@ struct CalibrateOptions {
   // the experiment's. Unset (auto): placed_cycle_for().
   std::optional<std::int64_t> placed_cycle;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
+  // Steady state, a placed twin, mu_s alone: after the design's fit, one packing more at
+  // kOneCycleAheadSpan x that fit, placed anew from the experiment's frame of every cycle
+  // before one of the window and driven that one cycle (each cycle a segment, its runs in
+  // out/ahead/cycle_<c>/runs), instead of the refined packings; the fit is the mean of the
+  // segments' own (fit_friction_by_segments(), docs/CALIBRATION.md, "One cycle ahead"): the
+  // twin starts each cycle where the experiment did, so the experiment's chaos over the
+  // window is not compared, only what one cycle does from where it was. Needs the
+  // experiment's frame of every cycle from the window's first - 1 to its last, and a window
+  // of 3 cycles or more; implies fit_only (no comparison run).
+  bool one_cycle_ahead = false;
   // Steady state: packings added about the design's fit (mu_s, or mu_s and mu_r jointly; at
   // refined_mu_s()), each its own seed (seed + replicas, ...), then the fit made again on every
   // run. They measure one packing's scatter where the experiment is, as realizations

@@ -95,6 +95,43 @@ ObservableFit fit_friction_to_steady_state(const SteadyState& experiment,
                                            const ObservableFitOptions& options = {},
                                            const std::vector<std::string>& only = {});
 
+// One cycle ahead (docs/CALIBRATION.md, "One cycle ahead"): the twin placed anew from the
+// experiment's frame of each cycle before one of the window and driven that one cycle. A
+// segment is one such cycle: the experiment's observables over it (with its placed
+// read-back as systematic errors) and the twin's runs over it (the same frictions and
+// seeds in every segment).
+struct SteadyStateSegment {
+  SteadyState experiment;
+  std::vector<SteadyStateRun> runs;
+};
+
+struct SegmentedFit {
+  double mu_s = 0;
+  std::array<double, 2> mu_s_ci95{0, 0};
+  double log_mu_s_sigma = 0;    // the mean's standard error that sets the interval
+  double scatter_sigma = 0;     // the segments' fits' standard deviation over sqrt(segments)
+  double systematic_sigma = 0;  // the experiment's systematic errors' share, the segments' mean
+  std::vector<double> segment_mu_s;  // each segment's own fit
+  std::vector<double> scatter;       // per observable: the runs' scatter about their trends
+  std::vector<std::string> names;
+  std::size_t runs = 0;  // per segment
+  std::string method;
+};
+
+// Each segment fitted as fit_friction_to_steady_state() fits a window, but against the
+// runs' covariance about their trends pooled over the segments (a segment's spare runs are
+// few, and one cycle's scatter is alike from cycle to cycle), shrunk towards its diagonal;
+// ln mu_s is the mean of the segments' fits, its standard error their scatter over
+// sqrt(segments) with the systematic share (common to every segment) in quadrature, the
+// 95 % interval with Student's t for segments - 1. The segments' scatter holds every error
+// that differs from cycle to cycle (the experiment's one-cycle chaos, the twin's, the
+// trend's); one common to every cycle only as far as the systematic errors say it. On the
+// observables every segment's experiment and runs have (or `only`). Throws Error for fewer
+// than 3 segments, or a segment the fit of a window would refuse.
+SegmentedFit fit_friction_by_segments(const std::vector<SteadyStateSegment>& segments,
+                                      const ObservableFitOptions& options = {},
+                                      const std::vector<std::string>& only = {});
+
 // The joint fit of the sliding and rolling frictions: the same model with each observable
 // a polynomial of total degree `degree` in (ln mu_s, ln mu_r) across runs that vary both
 // (e.g. a 3 x 3 grid per packing); Ceres fits both logs within the runs' ranges.

@@ -1750,18 +1750,19 @@ void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
 
 // The design's fit, then its packing one cycle ahead over every cycle of the window, and
 // the fit of the segments.
+// `cycles`: ahead_cycles(), checked before the design ran.
 void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& design,
-                         CalibrateSummary& s, std::ostream& report) {
+                         const std::vector<std::int64_t>& cycles, CalibrateSummary& s,
+                         std::ostream& report) {
   const CalibrateOptions& o = twin.options();
-  const std::vector<std::int64_t> cycles = ahead_cycles(twin);
   DesignFit first = design_fit(twin, design);
-  std::vector<double> mu;
-  for (double f : kOneCycleAheadSpan)
-    mu.push_back(three_digits(first.at.mu_s * f));
   const std::uint64_t seed = twin.next_seed(0);
+  std::vector<double> mu;
   std::vector<FrictionRunSpec> ahead;
-  for (double m : mu)
-    ahead.push_back({m, seed});
+  for (double f : kOneCycleAheadSpan) {
+    mu.push_back(three_digits(first.at.mu_s * f));
+    ahead.push_back({mu.back(), seed});
+  }
   first.line += "one cycle ahead: a packing more (seed " + std::to_string(seed) + ") at mu_s " +
                 refined_frictions_text(ahead) +
                 ", placed anew from the experiment's frame of each of cycles " +
@@ -1770,15 +1771,17 @@ void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& d
   twin.say(first.line);
   report << first.line << "\n";
   std::vector<SteadyStateSegment> segments;
-  std::vector<std::string> names = o.only;
+  std::vector<std::string> names;  // those every cycle's own fit keeps (within --only)
   for (std::int64_t c : cycles) {
     twin.say("cycle " + std::to_string(c) + ": placed from the experiment's frame of cycle " +
              std::to_string(c - 1));
     const CalibrateOptions so = segment_options(o, c, mu, seed);
     std::vector<std::string> kept;
     segments.push_back(ahead_segment(so, twin, kept));
-    names = names.empty() && c == cycles.front() ? kept : in_both(names, kept);
+    names = c == cycles.front() ? kept : in_both(names, kept);
   }
+  // Empty would read as "every observable" to the fit: the ones the scans' noise left out too.
+  if (names.empty()) throw Error("--one-cycle-ahead: no observable kept in every cycle's fit");
   ObservableFitOptions by_cycle = observable_fit_options(twin);
   by_cycle.degree = kOneCycleAheadDegree;
   const SegmentedFit fit = fit_friction_by_segments(segments, by_cycle, names);
@@ -2154,7 +2157,9 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   s.true_mu_r = true_friction(experiment.header(), "mu-r", options.true_mu_r);
   const bool steady = options.observables == CalibrationObservables::steady_state;
   if (steady) check_only(options, twin.measured_steady_state());
-  if (options.one_cycle_ahead) ahead_cycles(twin);  // refused before any run
+  // Refused before any run.
+  const std::vector<std::int64_t> ahead =
+      options.one_cycle_ahead ? ahead_cycles(twin) : std::vector<std::int64_t>{};
   std::string noise_model;
   const FrictionFitOptions fit_options =
       steady ? FrictionFitOptions{}
@@ -2169,7 +2174,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   if (options.auto_window) report << twin.choose_window(specs) << "\n";
   if (options.refined_packings() > 0) specs = refined_design(twin, std::move(specs), report);
   if (options.one_cycle_ahead) {
-    fit_one_cycle_ahead(twin, specs, s, report);
+    fit_one_cycle_ahead(twin, specs, ahead, s, report);
   } else if (options.joint()) {
     fit_joint(twin, specs, s, report);
   } else if (steady) {

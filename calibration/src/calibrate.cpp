@@ -1726,7 +1726,8 @@ void report_one_cycle_ahead(const Twin& twin, const SegmentedFit& fit,
   report << "; +-" << fit.scatter_sigma << " in ln mu_s from the cycles' scatter, "
          << fit.systematic_sigma << " from the experiment's systematic errors\n";
   if (!edge.empty()) report << "  note: " << edge << "\n";
-  report << "wrote " << (twin.options().out / "summary.json").string() << "\n";
+  report << "wrote " << (twin.options().out / "summary.json").string() << " and "
+         << s.written.size() - 1 << " figure files\n";
 }
 
 void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
@@ -1739,6 +1740,7 @@ void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
   j["one_cycle_ahead"] = true;
   j["cycles"] = cycles;
   j["cycle_mu_s"] = fit.segment_mu_s;
+  j["cycle_log_mu_s_sigma"] = fit.segment_log_sigma;
   j["ahead_mu_s"] = mu;
   j["observables"] = fit.names;
   j["design_fit"] = design_line;
@@ -1746,6 +1748,47 @@ void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
   j["deposit"] = preparation_name(twin.options().preparation);
   add_protocol(j, twin);
   write_json(twin.options().out / "summary.json", j);
+}
+
+// The one-cycle fit's figures: each cycle's own fit against the cycle (with the mean, its
+// interval and a pseudo-experiment's truth), and each observable's runs less the
+// experiment's of their cycle against mu_s, with the cycles' mean trend through them.
+std::vector<fs::path> one_cycle_ahead_figures(const fs::path& out, const SegmentedFit& fit,
+                                              const std::vector<std::int64_t>& cycles,
+                                              double true_mu_s) {
+  std::vector<double> x, error;
+  for (std::size_t k = 0; k < cycles.size(); ++k) {
+    x.push_back(double(cycles[k]));
+    error.push_back(fit.segment_mu_s[k] * fit.segment_log_sigma[k]);
+  }
+  std::vector<fs::path> written = plot_fits_apart(
+      out, "one_cycle_ahead_cycles", x, fit.segment_mu_s, error, fit.mu_s, fit.mu_s_ci95, true_mu_s,
+      "cycle (the twin placed from the experiment's frame before it)",
+      "one cycle ahead: each cycle's own fit (its GLS error)");
+  std::vector<ObservablePanel> panels;
+  for (std::size_t o = 0; o < fit.names.size(); ++o) {
+    ObservablePanel p;
+    p.label = steady_state_label(fit.names[o]);
+    p.run_mu_s = fit.run_mu_s;
+    p.run_value = fit.offset[o];
+    p.run_packing.assign(fit.run_mu_s.size(), 0);
+    p.curve_mu_s = fit.curve_mu_s;
+    p.curve = fit.curve_offset[o];
+    p.experiment_error = fit.offset_error[o];
+    panels.push_back(std::move(p));
+  }
+  char title[200];
+  std::snprintf(title, sizeof title,
+                "one cycle ahead, each run less the experiment at its cycle's end, cycles "
+                "%lld-%lld: mu_s = %.3g (95%% %.3g-%.3g)%s",
+                static_cast<long long>(cycles.front()), static_cast<long long>(cycles.back()),
+                fit.mu_s, fit.mu_s_ci95[0], fit.mu_s_ci95[1],
+                std::isfinite(true_mu_s) ? (", true " + number_text(true_mu_s)).c_str() : "");
+  const auto observables = plot_observable_fit(
+      out, "one_cycle_ahead_fit", panels, fit.mu_s, fit.mu_s_ci95, true_mu_s, title,
+      {"twin runs, every cycle", "experiment (0) +- the cycles' mean's error"});
+  written.insert(written.end(), observables.begin(), observables.end());
+  return written;
 }
 
 // The design's fit, then its packing one cycle ahead over every cycle of the window, and
@@ -1791,6 +1834,8 @@ void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& d
   s.simulations = s.simulations_fitted = design.size() + mu.size();
   write_one_cycle_ahead_summary(twin, fit, cycles, mu, first.line, s);
   s.written.push_back(o.out / "summary.json");
+  const std::vector<fs::path> figures = one_cycle_ahead_figures(o.out, fit, cycles, s.true_mu_s);
+  s.written.insert(s.written.end(), figures.begin(), figures.end());
   report_one_cycle_ahead(twin, fit, cycles, s, design_edge_note(fit.mu_s, segments.front().runs),
                          report);
 }

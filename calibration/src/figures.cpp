@@ -264,7 +264,7 @@ std::vector<fs::path> plot_curves(const fs::path& dir, const std::string& name,
 std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string& name,
                                           const std::vector<ObservablePanel>& panels, double mu_s,
                                           std::array<double, 2> ci95, double true_mu_s,
-                                          const std::string& title) {
+                                          const std::string& title, const ObservableFitKey& key) {
   if (panels.empty()) throw Error("observable fit figure: no observable");
   // The panels and, in the slot after them, the key alone: beside the last panel it would
   // run out of the figure wherever that is in the last column.
@@ -322,9 +322,9 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
   plot << "unset object 1\nunset object 2\nunset arrow 1\nunset arrow 2\nunset arrow 3\n"
        << "unset border\nunset tics\nunset grid\nunset xlabel\nunset ylabel\nunset logscale\n"
        << "set xrange [0:1]\nset yrange [0:1]\nset key center center vertical Left reverse\n"
-       << "plot NaN with points pt 7 ps 1.2 lc 1 title \"twin runs (colour: packing)\", "
+       << "plot NaN with points pt 7 ps 1.2 lc 1 title " << quoted(key.runs) << ", "
        << "NaN with lines lw 2 lc rgb \"#404040\" title \"trend\", "
-       << "NaN with lines lw 8 lc rgb \"#92c5de\" title \"experiment +- packing, systematic\", "
+       << "NaN with lines lw 8 lc rgb \"#92c5de\" title " << quoted(key.experiment) << ", "
        << "NaN with lines lw 8 lc rgb \"#f4a582\" title \"fitted mu_s, 95 %\", "
        << "NaN with lines lw 2 lc rgb \"#b2182b\" title \"fitted mu_s\""
        << (std::isfinite(true_mu_s)
@@ -333,6 +333,33 @@ std::vector<fs::path> plot_observable_fit(const fs::path& dir, const std::string
        << "\nunset multiplot\n";
   const std::string size = std::to_string(420 * columns) + "," + std::to_string(330 * rows + 60);
   return draw(dir, name, data.str(), plot.str(), size);
+}
+
+std::vector<fs::path> plot_fits_apart(const fs::path& dir, const std::string& name,
+                                      const std::vector<double>& x, const std::vector<double>& mu_s,
+                                      const std::vector<double>& error, double fit,
+                                      std::array<double, 2> ci95, double true_mu_s,
+                                      const std::string& x_label, const std::string& title) {
+  if (x.empty()) throw Error("fits apart figure: no fit");
+  std::ostringstream data, plot;
+  data.precision(8);
+  data << "# " << x_label << ", mu_s, its error\n";
+  for (std::size_t k = 0; k < x.size(); ++k)
+    data << x[k] << " " << mu_s[k] << " " << error[k] << "\n";
+  const auto [lo, hi] = std::minmax_element(x.begin(), x.end());
+  const double pad = std::max(0.5, (*hi - *lo) * 0.05);
+  plot << "set title " << quoted(title) << "\nset xlabel " << quoted(x_label)
+       << "\nset ylabel \"mu_s\"\nset grid\nset key outside bottom center horizontal\n"
+       << "set xrange [" << *lo - pad << ":" << *hi + pad << "]\n"
+       << "set object 1 rect from graph 0, first " << ci95[0] << " to graph 1, first " << ci95[1]
+       << " behind fc rgb \"#f4a582\" fs solid 0.35 noborder\n"
+       << "plot " << quoted(name + ".dat")
+       << " using 1:2:3 with yerrorbars pt 7 ps 1.2 lc rgb \"#5e3c99\" title \"each fit\", " << fit
+       << " with lines lw 2 lc rgb \"#b2182b\" title \"their mean, 95 % shaded\"";
+  if (std::isfinite(true_mu_s))
+    plot << ", " << true_mu_s << " with lines lw 2 dt 2 lc rgb \"black\" title \"true mu_s\"";
+  plot << "\n";
+  return draw(dir, name, data.str(), plot.str(), "800,500");
 }
 
 std::vector<fs::path> plot_joint_region(const fs::path& dir, const std::string& name,

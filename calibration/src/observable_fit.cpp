@@ -337,6 +337,27 @@ bool by_friction(const ObservableRun& a, const ObservableRun& b) {
   return a.mu_s < b.mu_s;
 }
 
+// The trend across the runs' frictions for figures, each observable less `less`, added
+// `weight` times into mu_s / curve (sized on the first call).
+void add_curve(const Trend& trend, const std::vector<ObservableRun>& runs,
+               const Eigen::VectorXd& less, double weight, std::vector<double>& mu_s,
+               std::vector<std::vector<double>>& curve) {
+  const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end(), by_friction);
+  const bool first = mu_s.empty();
+  if (first) {
+    mu_s.resize(kCurvePoints + 1);
+    curve.assign(std::size_t(less.size()), std::vector<double>(kCurvePoints + 1, 0.0));
+  }
+  for (int k = 0; k <= kCurvePoints; ++k) {
+    LogFriction x(1);
+    x(0) = std::log(lo->mu_s) + std::log(hi->mu_s / lo->mu_s) * k / kCurvePoints;
+    if (first) mu_s[std::size_t(k)] = std::exp(x(0));
+    const Eigen::VectorXd y = trend.predict(x) - less;
+    for (Eigen::Index o = 0; o < less.size(); ++o)
+      curve[std::size_t(o)][std::size_t(k)] += weight * y(o);
+  }
+}
+
 // The observables that the experiment and every run have (or `only`), as plain vectors.
 std::vector<std::string> common_observables(const SteadyState& experiment,
                                             const std::vector<SteadyStateRun>& runs,
@@ -461,16 +482,7 @@ ObservableFit fit_friction_to_observables(const std::vector<double>& experiment,
     fit.scatter.push_back(f.trend.scatter(o));
     fit.resolution.push_back(inflation * f.trend.scatter(o) / std::abs(slope(o)));
   }
-  fit.curve.resize(std::size_t(target.size()));
-  const auto [lo, hi] = std::minmax_element(runs.begin(), runs.end(), by_friction);
-  for (int k = 0; k <= kCurvePoints; ++k) {
-    LogFriction x(1);
-    x(0) = std::log(lo->mu_s) + std::log(hi->mu_s / lo->mu_s) * k / kCurvePoints;
-    fit.curve_mu_s.push_back(std::exp(x(0)));
-    const Eigen::VectorXd y = f.trend.predict(x);
-    for (Eigen::Index o = 0; o < target.size(); ++o)
-      fit.curve[std::size_t(o)].push_back(y(o));
-  }
+  add_curve(f.trend, runs, Eigen::VectorXd::Zero(target.size()), 1, fit.curve_mu_s, fit.curve);
   if (options.cross_validate) {
     const CrossValidation cv = cross_validate(runs, f.trend, 1, options.degree);
     fit.cross_validations = cv.count;
@@ -640,15 +652,26 @@ SegmentedFit fit_friction_by_segments(const std::vector<SteadyStateSegment>& seg
   }
   pooled /= spare;
   const Eigen::MatrixXd covariance = shrunk_covariance(pooled, spare);
+  const double n = double(segments.size());
   double sum = 0, systematic = 0;
+  Eigen::VectorXd experiment_systematic = Eigen::VectorXd::Zero(pooled.rows());
+  fit.offset.resize(fit.names.size());
   for (Segment& p : prepared) {
     p.trend.covariance = covariance;
     const OneFit f = fit_to_trend(p.target, p.runs, 1, p.trend);
     fit.segment_mu_s.push_back(std::exp(f.x(0)));
+    fit.segment_log_sigma.push_back(std::sqrt(f.covariance(0, 0)));
     sum += f.x(0);
     systematic += std::sqrt(systematic_share(f.trend, f.x, p.target.systematic)(0, 0));
+    experiment_systematic += p.target.systematic.cwiseSqrt() / n;
+    add_curve(f.trend, p.runs, p.target.value, 1 / n, fit.curve_mu_s, fit.curve_offset);
+    for (const ObservableRun& r : p.runs) {
+      fit.run_mu_s.push_back(r.mu_s);
+      for (std::size_t o = 0; o < fit.names.size(); ++o)
+        fit.offset[o].push_back(r.values[o] - p.target.value(Eigen::Index(o)));
+    }
   }
-  const double n = double(segments.size()), mean = sum / n;
+  const double mean = sum / n;
   double spread2 = 0;
   for (double mu : fit.segment_mu_s)
     spread2 += std::pow(std::log(mu) - mean, 2) / (n - 1);
@@ -659,8 +682,11 @@ SegmentedFit fit_friction_by_segments(const std::vector<SteadyStateSegment>& seg
   fit.mu_s = std::exp(mean);
   fit.mu_s_ci95 = {std::exp(mean - t * fit.log_mu_s_sigma),
                    std::exp(mean + t * fit.log_mu_s_sigma)};
-  for (Eigen::Index o = 0; o < pooled.rows(); ++o)
+  for (Eigen::Index o = 0; o < pooled.rows(); ++o) {
     fit.scatter.push_back(std::sqrt(pooled(o, o)));
+    fit.offset_error.push_back(
+        std::hypot(fit.scatter.back() / std::sqrt(n), experiment_systematic(o)));
+  }
   fit.runs = prepared[0].runs.size();
   fit.method = "the mean of " + std::to_string(segments.size()) + " segments' Ceres GLS fits of " +
                std::to_string(fit.names.size()) + " one-cycle observables against their trend in " +

@@ -534,6 +534,12 @@ TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
   EXPECT_GE(hi, 0.2) << json;
   EXPECT_EQ(json_value(json, "n_simulations"), 6 + 4) << json;
   EXPECT_NE(json.find("\"one_cycle_ahead\": true"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"cycle_log_mu_s_sigma\""), std::string::npos) << json;
+  // The figures: each cycle's fit, and the runs less the experiment's at each cycle's end.
+  for (const char* figure : {"one_cycle_ahead_cycles", "one_cycle_ahead_fit"}) {
+    for (const char* ext : {".png", ".dat", ".gp"})
+      EXPECT_TRUE(std::filesystem::exists(in_work("cal/" + std::string(figure) + ext))) << figure;
+  }
   // Each cycle's runs start from the experiment's frame before it, and drive that cycle only.
   for (std::int64_t c = 1; c <= 3; ++c) {
     const std::filesystem::path runs = in_work("cal/ahead/cycle_" + std::to_string(c) + "/runs");

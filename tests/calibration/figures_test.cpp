@@ -9,6 +9,7 @@
 #include <limits>
 #include <sstream>
 
+#include "granmem/core/error.hpp"
 #include "temp_dir.hpp"
 
 namespace granmem {
@@ -57,6 +58,22 @@ TEST_F(Figures, AnUnboundedIntervalIsDrawnToTheEdges) {
   // The key in the slot after the panels, not beside the last of them.
   EXPECT_NE(gp.find("set multiplot layout 1,2"), std::string::npos) << gp;
   EXPECT_NE(gp.find("set key center center"), std::string::npos) << gp;
+}
+
+// Fits made apart (one per cycle): each point with its error in the figure's table, the
+// mean's interval as the band, a pseudo-experiment's truth drawn; an unknown truth is not.
+TEST_F(Figures, FitsApartShowTheirPointsBandAndTruth) {
+  plot_fits_apart(dir_, "apart", {3, 4, 5}, {0.44, 0.47, 0.46}, {0.006, 0.005, 0.007}, 0.457,
+                  {0.43, 0.48}, 0.46, "cycle", "each cycle's fit");
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "apart.png"));
+  EXPECT_NE(read_all(dir_ / "apart.dat").find("4 0.47 0.005"), std::string::npos);
+  const std::string gp = read_all(dir_ / "apart.gp");
+  EXPECT_NE(gp.find("first 0.43 to graph 1, first 0.48"), std::string::npos) << gp;
+  EXPECT_NE(gp.find("0.46 with lines lw 2 dt 2"), std::string::npos) << gp;
+  plot_fits_apart(dir_, "unknown", {3, 4, 5}, {0.44, 0.47, 0.46}, {0.006, 0.005, 0.007}, 0.457,
+                  {0.43, 0.48}, std::nan(""), "cycle", "each cycle's fit");
+  EXPECT_EQ(read_all(dir_ / "unknown.gp").find("true mu_s"), std::string::npos);
+  EXPECT_THROW(plot_fits_apart(dir_, "none", {}, {}, {}, 0.4, {0.3, 0.5}, 0.4, "cycle", ""), Error);
 }
 
 // The frictions' tics are the design's own, but no two labels nearer than a label's width

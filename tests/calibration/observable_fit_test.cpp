@@ -553,6 +553,7 @@ TEST(ObservableFit, TheJointFitOfMuSAndMuRHoldsBothAtTheirRate) {
 // rotation, their one-cycle noise ~0.01 in ln mu_s each.
 struct SyntheticSegments {
   std::mt19937_64 random;
+  double noise_scale = 1;  // the runs' and the experiment's noise, as a multiple of the model's
   std::normal_distribution<double> normal{0, 1};
   std::vector<double> values(double mu, const std::vector<double>& cycle, double noise) {
     const double x = std::log(mu);
@@ -574,10 +575,10 @@ struct SyntheticSegments {
       const std::vector<double> cycle{0.002 * normal(random), 0.3 * normal(random),
                                       0.0005 * normal(random)};
       SteadyStateSegment seg;
-      seg.experiment = state(values(truth, cycle, 2.0));
+      seg.experiment = state(values(truth, cycle, 2.0 * noise_scale));
       std::uint64_t seed = 3;
       for (double f : {1 / 1.2, 1 / 1.07, 1.07, 1.2})
-        seg.runs.push_back({centre * f, seed++, state(values(centre * f, cycle, 1.0))});
+        seg.runs.push_back({centre * f, seed++, state(values(centre * f, cycle, noise_scale))});
       out.push_back(std::move(seg));
     }
     return out;
@@ -608,6 +609,34 @@ TEST(ObservableFit, OneCycleAheadSegmentsHoldTheTruthAtTheirRate) {
   // The error is what the sigma says (Student's t for 9 dof makes the mean's z RMS ~1.13).
   EXPECT_GT(z_rms, 0.8);
   EXPECT_LT(z_rms, 1.4);
+}
+
+TEST(ObservableFit, OneCycleAheadOffsetsCrossZeroAtTheTruth) {
+  // Nearly noiseless segments: every run less its cycle's experiment is the model's change
+  // from the truth, the same in every cycle whatever the cycle's own offset, so the cycles'
+  // mean trend of it crosses 0 at the truth for each observable.
+  SyntheticSegments g{std::mt19937_64(11), 1e-3};
+  const std::vector<SteadyStateSegment> segments = g.draw(0.25, 5);
+  const SegmentedFit fit = fit_friction_by_segments(segments);
+  ASSERT_EQ(fit.run_mu_s.size(), 5u * 4u);
+  ASSERT_EQ(fit.offset.size(), 3u);
+  EXPECT_DOUBLE_EQ(fit.offset[1][6],
+                   segments[1].runs[2].state.values[1] - segments[1].experiment.values[1]);
+  EXPECT_NEAR(fit.mu_s, 0.25, 0.25 * 1e-3);
+  ASSERT_EQ(fit.segment_log_sigma.size(), 5u);
+  for (double sigma : fit.segment_log_sigma)
+    EXPECT_LT(sigma, 1e-3);
+  for (std::size_t o = 0; o < 3; ++o) {
+    const std::vector<double>& y = fit.curve_offset[o];
+    const double span = std::abs(y.back() - y.front());
+    std::size_t k = 0;
+    while (k + 1 < y.size() && fit.curve_mu_s[k + 1] < 0.25)
+      ++k;
+    const double w =
+        std::log(0.25 / fit.curve_mu_s[k]) / std::log(fit.curve_mu_s[k + 1] / fit.curve_mu_s[k]);
+    EXPECT_LT(std::abs(y[k] + w * (y[k + 1] - y[k])), 1e-2 * span) << fit.names[o];
+    EXPECT_GT(fit.offset_error[o], 0);
+  }
 }
 
 TEST(ObservableFit, OneCycleAheadNeedsThreeSegmentsAndTheSameObservables) {

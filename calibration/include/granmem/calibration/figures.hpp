@@ -74,11 +74,26 @@ struct ObservablePanel {
   std::vector<double> curve_mu_s, curve;
   double experiment = 0, experiment_error = 0;
 };
+// What the key calls the runs' points and the experiment's band.
+struct ObservableFitKey {
+  std::string runs = "twin runs (colour: packing)";
+  std::string experiment = "experiment +- packing, systematic";
+};
 std::vector<std::filesystem::path> plot_observable_fit(const std::filesystem::path& dir,
                                                        const std::string& name,
                                                        const std::vector<ObservablePanel>& panels,
                                                        double mu_s, std::array<double, 2> ci95,
-                                                       double true_mu_s, const std::string& title);
+                                                       double true_mu_s, const std::string& title,
+                                                       const ObservableFitKey& key = {});
+
+// Fits of one friction made apart (e.g. one per cycle) against what tells them apart (x):
+// each with its error bar, the combined fit as a line, its 95 % interval as a shaded
+// band, and the true mu_s of a pseudo-experiment (NaN: unknown) dashed.
+std::vector<std::filesystem::path> plot_fits_apart(
+    const std::filesystem::path& dir, const std::string& name, const std::vector<double>& x,
+    const std::vector<double>& mu_s, const std::vector<double>& error, double fit,
+    std::array<double, 2> ci95, double true_mu_s, const std::string& x_label,
+    const std::string& title);
 
 // A joint fit of two frictions: the twin's design points, the joint 95 % region's
 // boundary, the fit and, for a pseudo-experiment, the truth (NaN: unknown), log-log.

@@ -111,8 +111,18 @@ struct SegmentedFit {
   double log_mu_s_sigma = 0;    // the mean's standard error that sets the interval
   double scatter_sigma = 0;     // the segments' fits' standard deviation over sqrt(segments)
   double systematic_sigma = 0;  // the experiment's systematic errors' share, the segments' mean
-  std::vector<double> segment_mu_s;  // each segment's own fit
-  std::vector<double> scatter;       // per observable: the runs' scatter about their trends
+  std::vector<double> segment_mu_s;       // each segment's own fit
+  std::vector<double> segment_log_sigma;  // its GLS standard error in ln mu_s
+  std::vector<double> scatter;            // per observable: the runs' scatter about their trends
+  // For figures, per observable: every segment's runs less that segment's experiment
+  // (offset[o][k] at run_mu_s[k]); the segments' trends less their experiments, averaged
+  // (curve_offset[o][k] at curve_mu_s[k]), which crosses 0 near the fit; and the error of
+  // that mean at the experiment (the scatter over sqrt(segments), the systematic error).
+  std::vector<double> run_mu_s;
+  std::vector<std::vector<double>> offset;
+  std::vector<double> curve_mu_s;
+  std::vector<std::vector<double>> curve_offset;
+  std::vector<double> offset_error;
   std::vector<std::string> names;
   std::size_t runs = 0;  // per segment
   std::string method;

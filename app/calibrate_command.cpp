@@ -34,7 +34,8 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                                preparation = "auto", summaries = "pooled",
                                                observables = "steady-state", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
-    bool subtract_drift = true, fit_only = false, one_cycle_ahead = false;
+    bool subtract_drift = true, fit_only = false, one_cycle_ahead = false, window_fit = false;
+    int ahead_burn_in = 1;
     int threads = 0, degree = 0, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto", placed_cycle = "auto";
     std::string true_mu_s, true_mu_r;
@@ -159,7 +160,18 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                 "fit/1.2, fit/1.07, fit x 1.07 and fit x 1.2, placed anew from the experiment's "
                 "frame of every cycle before one of the window and driven that one cycle; the fit "
                 "the mean of the cycles' own, its error their scatter (no refined packings, no "
-                "comparison run; docs/CALIBRATION.md, \"One cycle ahead\")");
+                "comparison run; docs/CALIBRATION.md, \"One cycle ahead\"); the default where "
+                "the experiment has a frame of every cycle of a window of 5 or more and the one "
+                "before it, and --refine, --placed-cycle and --window auto are not given");
+  cmd->add_flag("--window-fit", args->window_fit,
+                "steady-state: fit the window's means (the design, its refined packings), not "
+                "one cycle ahead, where that would be the default")
+      ->excludes("--one-cycle-ahead");
+  cmd->add_option("--ahead-burn-in", args->ahead_burn_in,
+                  "one cycle ahead: cycles each run drives before the one compared, placed "
+                  "from the experiment's frame that many cycles earlier (its contacts' "
+                  "tangential history loaded again)")
+      ->capture_default_str();
   cmd->add_option("--threads", args->threads,
                   "runs at once, and the cores they use (default: one per core; the last run also "
                   "takes the cores the others leave)");
@@ -209,7 +221,9 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
     o.placed_jitter = parse_placed_jitter(args->placed_jitter, "--placed-jitter");
     o.placed_cycle = parse_placed_cycle(args->placed_cycle, "--placed-cycle");
     o.fit_only = args->fit_only;
-    o.one_cycle_ahead = args->one_cycle_ahead;
+    if (args->one_cycle_ahead) o.one_cycle_ahead = true;
+    if (args->window_fit) o.one_cycle_ahead = false;
+    o.ahead_burn_in = args->ahead_burn_in;
     if (!args->true_mu_s.empty()) o.true_mu_s = one_friction(args->true_mu_s, "--true-mu-s");
     if (!args->true_mu_r.empty()) o.true_mu_r = one_friction(args->true_mu_r, "--true-mu-r");
     o.parallel = args->threads;

@@ -41,7 +41,8 @@ for case in "$@"; do
     --readings readings.csv --out tracks_readings.h5 > link_readings.txt 2>&1
   [ -f fit/summary.json ] || "$granmem" --config "$protocol" calibrate --experiment tracks.h5 \
     --out fit --fit-only --true-mu-s "$mu" > fit.log 2>&1
-  mkdir -p fit_readings && ln -sfn ../fit/runs fit_readings/runs
+  # the twin's runs reused: the design's, and one cycle ahead's where their frictions agree
+  mkdir -p fit_readings && ln -sfn ../fit/runs fit_readings/runs && ln -sfn ../fit/ahead fit_readings/ahead
   [ -f fit_readings/summary.json ] || "$granmem" --config "$protocol" calibrate \
     --experiment tracks_readings.h5 --out fit_readings --fit-only --true-mu-s "$mu" \
     > fit_readings.log 2>&1

@@ -207,12 +207,46 @@ TwinPreparation resolved_preparation(const CalibrateOptions& options,
              : TwinPreparation::each;
 }
 
+std::vector<std::int64_t> comparable_ahead_cycles(const TrajectoryReader& experiment,
+                                                  std::pair<std::int64_t, std::int64_t> window,
+                                                  int burn_in) {
+  std::vector<std::int64_t> cycles;
+  for (std::int64_t c = window.first; c <= window.second; ++c) {
+    const std::int64_t placed = c - 1 - burn_in;
+    bool framed = placed >= 0 && placeable_packing_at(experiment, placed);
+    for (std::int64_t f = placed + 1; framed && f <= c; ++f)
+      framed = frame_of_cycle(experiment, f).has_value();
+    if (framed) cycles.push_back(c);
+  }
+  return cycles;
+}
+
+namespace {
+
+// CalibrateOptions::one_cycle_ahead resolved: as given, else where every condition of the
+// default holds (the options' comment).
+bool resolved_one_cycle_ahead(const CalibrateOptions& given, const CalibrateOptions& o,
+                              const TrajectoryReader& experiment) {
+  if (given.one_cycle_ahead) return *given.one_cycle_ahead;
+  const bool steady = o.observables == CalibrationObservables::steady_state;
+  if (!steady || o.joint() || o.preparation != TwinPreparation::experiment || given.refine ||
+      given.auto_window || given.placed_cycle) {
+    return false;
+  }
+  return std::int64_t(
+             comparable_ahead_cycles(experiment, compared_window(o, experiment), o.ahead_burn_in)
+                 .size()) >= kOneCycleAheadByDefault;
+}
+
+}  // namespace
+
 CalibrateOptions resolved_options(const CalibrateOptions& given,
                                   const TrajectoryReader& experiment) {
   CalibrateOptions options = given;
   for (const auto& [key, value] : protocol_left_to_experiment(given, experiment.header()))
     options.twin[key] = value;
   options.preparation = resolved_preparation(given, experiment);
+  options.one_cycle_ahead = resolved_one_cycle_ahead(given, options, experiment);
   if (options.placed_cycle && options.preparation != TwinPreparation::experiment) {
     const bool asked = given.preparation != TwinPreparation::automatic;
     throw Error("--placed-cycle " + std::to_string(*options.placed_cycle) +
@@ -1643,6 +1677,7 @@ void fit_steady_state(const Twin& twin, const std::vector<FrictionRunSpec>& spec
 // One cycle ahead (CalibrateOptions::one_cycle_ahead): the experiment's cycles each a
 // segment, its frame before it the twin's start, its own frame the compared.
 std::vector<std::int64_t> ahead_cycles(const Twin& twin) {
+  const CalibrateOptions& o = twin.options();
   const auto [first, last] = twin.observe.window;
   if (last - first + 1 < 3) {
     throw Error(
@@ -1650,16 +1685,14 @@ std::vector<std::int64_t> ahead_cycles(const Twin& twin) {
         "error); this one has " +
         std::to_string(last - first + 1));
   }
-  std::vector<std::int64_t> cycles;
-  for (std::int64_t c = first; c <= last; ++c) {
-    for (std::int64_t f : {c - 1, c}) {
-      if (!frame_of_cycle(twin.experiment(), f)) {
-        throw Error("--one-cycle-ahead: " + twin.options().experiment.string() +
-                    " has no frame of cycle " + std::to_string(f) +
-                    " (every cycle of the window and the one before it are needed)");
-      }
-    }
-    cycles.push_back(c);
+  const std::vector<std::int64_t> cycles =
+      comparable_ahead_cycles(twin.experiment(), twin.observe.window, o.ahead_burn_in);
+  if (cycles.size() < 3) {
+    throw Error("--one-cycle-ahead: " + o.experiment.string() + " has what " +
+                std::to_string(cycles.size()) + " of the window's cycles " + std::to_string(first) +
+                "-" + std::to_string(last) + " need (each its frame and a placeable one " +
+                std::to_string(o.ahead_burn_in + 1) +
+                " before it, and any between); at least 3 (their scatter is the fit's error)");
   }
   return cycles;
 }
@@ -1667,15 +1700,18 @@ std::vector<std::int64_t> ahead_cycles(const Twin& twin) {
 // A segment's trend in ln mu_s across the ahead packing's four frictions (kOneCycleAheadSpan).
 constexpr int kOneCycleAheadDegree = 2;
 
-// A segment's options: the ahead packing (`mu`, its own seed) placed from cycle - 1 and
-// compared over that cycle alone, in its own folder.
+// A segment's options: the ahead packing (`mu`, its own seed) placed from cycle - 1 (less
+// the burn-in) and compared over that cycle alone, in its own folder.
 CalibrateOptions segment_options(const CalibrateOptions& o, std::int64_t cycle,
                                  const std::vector<double>& mu, std::uint64_t seed) {
   CalibrateOptions s = o;
   s.one_cycle_ahead = false;
-  s.placed_cycle = cycle - 1;
+  s.ahead_burn_in = 0;
+  s.placed_cycle = cycle - 1 - o.ahead_burn_in;
   s.window = std::pair{cycle, cycle};
-  s.out = o.out / "ahead" / ("cycle_" + std::to_string(cycle));
+  s.out = o.out / "ahead" /
+          ("cycle_" + std::to_string(cycle) +
+           (o.ahead_burn_in ? "_from_" + std::to_string(*s.placed_cycle) : std::string()));
   s.mu_s = mu;
   s.replicas = 1;
   s.refine = 0;
@@ -1742,6 +1778,7 @@ void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
   j["cycle_mu_s"] = fit.segment_mu_s;
   j["cycle_log_mu_s_sigma"] = fit.segment_log_sigma;
   j["ahead_mu_s"] = mu;
+  j["ahead_burn_in"] = twin.options().ahead_burn_in;
   j["observables"] = fit.names;
   j["design_fit"] = design_line;
   j["n_simulations"] = s.simulations;
@@ -1806,18 +1843,21 @@ void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& d
     mu.push_back(three_digits(first.at.mu_s * f));
     ahead.push_back({mu.back(), seed});
   }
-  first.line += "one cycle ahead: a packing more (seed " + std::to_string(seed) + ") at mu_s " +
-                refined_frictions_text(ahead) +
-                ", placed anew from the experiment's frame of each of cycles " +
-                std::to_string(cycles.front() - 1) + "-" + std::to_string(cycles.back() - 1) +
-                " and driven the next";
+  first.line +=
+      "one cycle ahead: a packing more (seed " + std::to_string(seed) + ") at mu_s " +
+      refined_frictions_text(ahead) +
+      ", placed anew from the experiment's frame of each of cycles " +
+      std::to_string(cycles.front() - 1 - o.ahead_burn_in) + "-" +
+      std::to_string(cycles.back() - 1 - o.ahead_burn_in) + " and driven " +
+      (o.ahead_burn_in ? std::to_string(o.ahead_burn_in + 1) + " cycles, the last compared"
+                       : std::string("the next"));
   twin.say(first.line);
   report << first.line << "\n";
   std::vector<SteadyStateSegment> segments;
   std::vector<std::string> names;  // those every cycle's own fit keeps (within --only)
   for (std::int64_t c : cycles) {
     twin.say("cycle " + std::to_string(c) + ": placed from the experiment's frame of cycle " +
-             std::to_string(c - 1));
+             std::to_string(c - 1 - o.ahead_burn_in));
     const CalibrateOptions so = segment_options(o, c, mu, seed);
     std::vector<std::string> kept;
     segments.push_back(ahead_segment(so, twin, kept));
@@ -2087,8 +2127,7 @@ CalibrateOptions CalibrateOptions::with_default_design() const {
                                  : Design{{0.03, 0.05, 0.08, 0.12, 0.2, 0.3, 0.5}, 2};
   CalibrateOptions o = *this;
   // A design given is run as given: refined only where asked (one cycle ahead: never).
-  if (!o.refine)
-    o.refine = o.mu_s.empty() && o.replicas == 0 && !one_cycle_ahead ? design.refine : 0;
+  if (!o.refine) o.refine = o.mu_s.empty() && o.replicas == 0 && !ahead() ? design.refine : 0;
   if (o.mu_s.empty()) o.mu_s = design.mu_s;
   if (o.replicas == 0) o.replicas = design.replicas;
   return o;
@@ -2129,7 +2168,7 @@ void CalibrateOptions::validate() const {
   if (!std::isnan(placed_jitter) && !(placed_jitter > 0 && std::isfinite(placed_jitter))) {
     throw Error("--placed-jitter: a length > 0 (replicas not moved would all be the same run)");
   }
-  if (one_cycle_ahead) {
+  if (ahead()) {
     if (!steady || joint() || preparation != TwinPreparation::experiment) {
       throw Error(
           "--one-cycle-ahead: only for a steady-state fit of mu_s on a twin placed from the "
@@ -2141,6 +2180,7 @@ void CalibrateOptions::validate() const {
           "is placed from every cycle's frame, after the design's fit)");
     }
   }
+  if (ahead_burn_in < 0) throw Error("--ahead-burn-in: a number of cycles, 0 or more");
   if (placed_cycle && *placed_cycle < 0) throw Error("--placed-cycle: a cycle, 0 or later");
   if (placed_cycle && auto_window) {
     throw Error(
@@ -2204,7 +2244,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   if (steady) check_only(options, twin.measured_steady_state());
   // Refused before any run.
   const std::vector<std::int64_t> ahead =
-      options.one_cycle_ahead ? ahead_cycles(twin) : std::vector<std::int64_t>{};
+      options.ahead() ? ahead_cycles(twin) : std::vector<std::int64_t>{};
   std::string noise_model;
   const FrictionFitOptions fit_options =
       steady ? FrictionFitOptions{}
@@ -2218,7 +2258,7 @@ CalibrateSummary calibrate(const CalibrateOptions& given) {
   std::ostringstream report;
   if (options.auto_window) report << twin.choose_window(specs) << "\n";
   if (options.refined_packings() > 0) specs = refined_design(twin, std::move(specs), report);
-  if (options.one_cycle_ahead) {
+  if (options.ahead()) {
     fit_one_cycle_ahead(twin, specs, ahead, s, report);
   } else if (options.joint()) {
     fit_joint(twin, specs, s, report);

@@ -327,8 +327,8 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
               observables="steady-state", only=(), window=None, noise="auto",
               summaries="pooled", wall_distance=0, subtract_drift=True, degree=0, replicas=None,
               refine=None, axis_noise="auto", deposit="auto", placed_jitter="auto",
-              placed_cycle="auto", fit_only=False, one_cycle_ahead=False, true_mu_s=None,
-              true_mu_r=None, parallel=0, progress=None, **twin):
+              placed_cycle="auto", fit_only=False, one_cycle_ahead=None, ahead_burn_in=1,
+              true_mu_s=None, true_mu_r=None, parallel=0, progress=None, **twin):
     """The friction fit, as ``granmem calibrate``: a simulated twin of the ``experiment``
     (a trajectory store, tracked scans or a pseudo-experiment) run at each friction of
     ``mu_s`` (and each ``mu_r`` for a joint fit of both) on ``replicas`` packings, in the
@@ -360,7 +360,13 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
     placed twin, mu_s): after the design's fit, one packing more at fit / 1.2, / 1.07, x 1.07
     and x 1.2, placed anew from the experiment's frame of every cycle before one of the window
     and driven that one cycle; the fit the mean of the cycles' own, its error their scatter
-    (no refined packings, no comparison run; docs/CALIBRATION.md, "One cycle ahead").
+    (no refined packings, no comparison run; docs/CALIBRATION.md, "One cycle ahead");
+    ``None``: on where the experiment has the frames of 5 or more of the window's cycles, and
+    ``refine``, ``placed_cycle`` and an "auto" ``window`` are not given (the default);
+    ``False``: the window's means. ``ahead_burn_in``: the cycles each of its runs drives
+    before the one compared, placed from the frame that many cycles earlier (1: the placed
+    contacts' tangential history loaded again by a cycle; each compared cycle needs its
+    frame and those ``ahead_burn_in`` + 1 before it).
 
     ``mu_s`` and ``replicas`` left ``None``: the design measured for each fit, for
     "steady-state" 0.05, 0.14, 0.4 on 3 packings, then 3 more at their fit (12 runs; a twin
@@ -388,5 +394,7 @@ def calibrate(experiment, out, mu_s=None, mu_r=None,
                                   axis_noise, str) else repr(float(axis_noise)),
                               deposit, "auto" if placed_jitter == "auto" else _length(placed_jitter),
                               "auto" if placed_cycle is None else str(placed_cycle), bool(fit_only),
-                              bool(one_cycle_ahead), _optional_float(true_mu_s),
+                              None if one_cycle_ahead is None else bool(one_cycle_ahead),
+                              int(ahead_burn_in),
+                              _optional_float(true_mu_s),
                               _optional_float(true_mu_r), int(parallel), twin, progress)

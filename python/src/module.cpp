@@ -758,7 +758,8 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
                       bool subtract_drift, int degree, const std::optional<int>& replicas,
                       const std::optional<int>& refine, const std::string& axis_noise,
                       const std::string& deposit, const std::string& placed_jitter,
-                      const std::string& placed_cycle, bool fit_only, bool one_cycle_ahead,
+                      const std::string& placed_cycle, bool fit_only,
+                      const std::optional<bool>& one_cycle_ahead, int ahead_burn_in,
                       const std::optional<double>& true_mu_s,
                       const std::optional<double>& true_mu_r, int parallel, const py::dict& twin,
                       const py::object& progress) {
@@ -796,6 +797,7 @@ py::dict calibrate_py(const std::filesystem::path& experiment, const std::filesy
   o.placed_cycle = parse_placed_cycle(placed_cycle, "placed_cycle");
   o.fit_only = fit_only;
   o.one_cycle_ahead = one_cycle_ahead;
+  o.ahead_burn_in = ahead_burn_in;
   o.true_mu_s = true_mu_s;
   o.true_mu_r = true_mu_r;
   o.parallel = parallel;
@@ -930,9 +932,10 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("degree") = CalibrateOptions{}.degree, py::arg("replicas") = py::none(),
         py::arg("refine") = py::none(), py::arg("axis_noise") = "auto", py::arg("deposit") = "auto",
         py::arg("placed_jitter") = "auto", py::arg("placed_cycle") = "auto",
-        py::arg("fit_only") = false, py::arg("one_cycle_ahead") = false,
-        py::arg("true_mu_s") = py::none(), py::arg("true_mu_r") = py::none(),
-        py::arg("parallel") = 0, py::arg("twin") = py::dict(), py::arg("progress") = py::none());
+        py::arg("fit_only") = false, py::arg("one_cycle_ahead") = py::none(),
+        py::arg("ahead_burn_in") = 1, py::arg("true_mu_s") = py::none(),
+        py::arg("true_mu_r") = py::none(), py::arg("parallel") = 0, py::arg("twin") = py::dict(),
+        py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,

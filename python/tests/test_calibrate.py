@@ -209,13 +209,14 @@ def test_a_rotation_made_of_axis_noise_is_left_out(tmp_path, cli, experiment):
 
 
 def test_one_cycle_ahead_is_the_command_lines(tmp_path, cli, experiment):
-    ahead = dict(FIT, mu_s=[0.1, 0.2, 0.4], window=(1, 3), fit_only=False, one_cycle_ahead=True)
+    ahead = dict(FIT, mu_s=[0.1, 0.2, 0.4], window=(1, 3), fit_only=False, one_cycle_ahead=True,
+                 ahead_burn_in=0)
     fit = granmem.calibrate(experiment, tmp_path / "py", **ahead, **TWIN)
     assert fit["simulations"] == 10  # 3 frictions x 2 packings, and the packing ahead at 4
     lo, hi = fit["mu_s_ci95"]
     assert lo <= 0.2 <= hi
     out = cli("calibrate", "--experiment", "exp.h5", "--out", "cli", "--mu-s", "0.1,0.2,0.4",
-              "--window", "1:3", "--one-cycle-ahead", *TWIN_FLAGS)
+              "--window", "1:3", "--one-cycle-ahead", "--ahead-burn-in", "0", *TWIN_FLAGS)
     assert out.splitlines()[:-1] == fit["report"].splitlines()[:-1]
     assert "3 cycles' own fits" in out
 

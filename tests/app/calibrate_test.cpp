@@ -521,9 +521,24 @@ TEST_F(Calibrate, StartsTheTwinFromTheExperimentsOwnPacking) {
 // --one-cycle-ahead: after the design's fit, one packing more at four frictions about it,
 // placed anew from the experiment's frame before each cycle of the window and driven that
 // cycle; the fit is the mean of the cycles' own, and holds the truth.
+// One cycle ahead's packing in `runs`: its 4 frictions (seed 3), each run from the
+// experiment's frame of cycle `from` to cycle `to`.
+void expect_ahead_runs(const std::filesystem::path& runs, std::int64_t from, std::int64_t to) {
+  int found = 0;
+  for (const auto& e : std::filesystem::directory_iterator(runs)) {
+    if (e.path().extension() != ".h5") continue;
+    ++found;
+    const TrajectoryReader run(e.path().string());
+    EXPECT_EQ(run.steps().front(), from) << e.path();
+    EXPECT_EQ(run.steps().back(), to) << e.path();
+    EXPECT_NE(e.path().filename().string().find("_seed_3.h5"), std::string::npos) << e.path();
+  }
+  EXPECT_EQ(found, 4) << runs;
+}
+
 TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
-  const std::vector<std::string> design{"--window", "1:3", "--mu-s", "0.1,0.2,0.4",
-                                        "--one-cycle-ahead"};
+  const std::vector<std::string> design{
+      "--window", "1:3", "--mu-s", "0.1,0.2,0.4", "--one-cycle-ahead", "--ahead-burn-in", "0"};
   const RunResult r = granmem_ok(calibrate(design));
   EXPECT_NE(r.out.find("one cycle ahead: a packing more (seed 3) at mu_s "), std::string::npos)
       << r.out;
@@ -541,19 +556,8 @@ TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
       EXPECT_TRUE(std::filesystem::exists(in_work("cal/" + std::string(figure) + ext))) << figure;
   }
   // Each cycle's runs start from the experiment's frame before it, and drive that cycle only.
-  for (std::int64_t c = 1; c <= 3; ++c) {
-    const std::filesystem::path runs = in_work("cal/ahead/cycle_" + std::to_string(c) + "/runs");
-    int found = 0;
-    for (const auto& e : std::filesystem::directory_iterator(runs)) {
-      if (e.path().extension() != ".h5") continue;
-      ++found;
-      const TrajectoryReader run(e.path().string());
-      EXPECT_EQ(run.steps().front(), c - 1) << e.path();
-      EXPECT_EQ(run.steps().back(), c) << e.path();
-      EXPECT_NE(e.path().filename().string().find("_seed_3.h5"), std::string::npos) << e.path();
-    }
-    EXPECT_EQ(found, 4) << runs;
-  }
+  for (std::int64_t c = 1; c <= 3; ++c)
+    expect_ahead_runs(in_work("cal/ahead/cycle_" + std::to_string(c) + "/runs"), c - 1, c);
   // A second call reuses every run.
   const RunResult again = granmem_ok(calibrate(design));
   EXPECT_EQ(again.err.find(" runs, "), std::string::npos) << again.err;
@@ -568,6 +572,40 @@ TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
   bad = calibrate(design);
   bad.insert(bad.end(), {"--deposit", "each"});
   expect_clean_failure(bad, {"--one-cycle-ahead", "placed from the experiment's packing"});
+  // Cycle 1 would need a frame of cycle -1.
+  bad = calibrate({"--window", "1:3", "--mu-s", "0.1,0.2,0.4", "--one-cycle-ahead"});
+  expect_clean_failure(bad, {"--one-cycle-ahead", "2 of the window's cycles 1-3"});
+}
+
+// Left to it, calibrate fits one cycle ahead where the experiment has every cycle's frame over
+// a window of 5 or more: each run placed from the frame two cycles before the one compared
+// (its contacts' history loaded again by the first), the window fit where asked.
+TEST_F(Calibrate, FitsOneCycleAheadByDefaultAfterABurnInCycle) {
+  std::vector<std::string> sim{"simulate", "--cycles", "6",       "--seed",    "8", "--mu-s",
+                               "0.2",      "--out",    "exp6.h5", "--threads", "1"};
+  sim.insert(sim.end(), kTwin.begin(), kTwin.end());
+  granmem_ok(sim);
+  std::vector<std::string> args = calibrate({"--mu-s", "0.1,0.2,0.4"});
+  args[2] = "exp6.h5";
+  const RunResult r = granmem_ok(args);
+  // The default window is cycles 1-6; cycle 1 has no frame two cycles before it.
+  EXPECT_NE(r.out.find("5 cycles' own fits (cycle: mu_s): 2: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("driven 2 cycles, the last compared"), std::string::npos) << r.out;
+  const std::string json = read_text(in_work("cal/summary.json"));
+  const auto [lo, hi] = expect_fit_in_its_interval(json);
+  EXPECT_LE(lo, 0.2) << json;
+  EXPECT_GE(hi, 0.2) << json;
+  EXPECT_EQ(json_value(json, "ahead_burn_in"), 1) << json;
+  for (std::int64_t c = 2; c <= 6; ++c) {
+    expect_ahead_runs(in_work("cal/ahead/cycle_" + std::to_string(c) + "_from_" +
+                              std::to_string(c - 2) + "/runs"),
+                      c - 2, c);
+  }
+  // --window-fit: the design's runs reused, the window's means fitted.
+  args.push_back("--window-fit");
+  const RunResult window = granmem_ok(args);
+  EXPECT_EQ(window.out.find("one cycle ahead"), std::string::npos) << window.out;
+  EXPECT_EQ(read_text(in_work("cal/summary.json")).find("\"one_cycle_ahead\""), std::string::npos);
 }
 
 TEST_F(Calibrate, ProbesWhatPlacingFromScansDoesToTheTwin) {

@@ -86,9 +86,10 @@ TEST(CalibrateOptions, APlacedTwinsRefinedPackingsHoldTheTrendOnBothSidesOfItsFi
 
 class ResolvedOptions : public testing::TempDirTest {
  protected:
-  // A two-grain store of 5 mm grains with frames of cycles 0 to `last`: a simulation's
-  // (orientations), or a scan's (positions' standard errors of `error`, m).
-  std::filesystem::path store(bool scan, double error = 0, std::int64_t last = 0) {
+  // A two-grain store of 5 mm grains with frames of cycles 0 to `last` (but `missing`): a
+  // simulation's (orientations), or a scan's (positions' standard errors of `error`, m).
+  std::filesystem::path store(bool scan, double error = 0, std::int64_t last = 0,
+                              std::int64_t missing = -1) {
     Trajectories t;
     t.header.id = {1, 2};
     t.header.radius = {0.0025, 0.0025};
@@ -105,10 +106,10 @@ class ResolvedOptions : public testing::TempDirTest {
     }
     for (std::int64_t cycle = 0; cycle <= last; ++cycle) {
       f.step = cycle;
-      t.frames.push_back(f);
+      if (cycle != missing) t.frames.push_back(f);
     }
     const auto p = path((scan ? "scan_" + std::to_string(error) : std::string("sim")) + "_" +
-                        std::to_string(last) + ".h5");
+                        std::to_string(last) + "_" + std::to_string(missing) + ".h5");
     write_trajectories(p, t);
     return p;
   }
@@ -141,6 +142,57 @@ TEST_F(ResolvedOptions, APlacedTwinGetsItsOwnDesignAndAPouredOneItsOwn) {
   EXPECT_EQ(given.mu_s, steady.mu_s);
   EXPECT_EQ(given.replicas, 3);
   EXPECT_EQ(given.refine, 0);
+}
+
+// One cycle ahead is the default where it can be and nothing asked is the window fit's: a
+// placed twin fitting mu_s over a window of 5 cycles or more (kOneCycleAheadByDefault) whose
+// every cycle and the one before it the experiment holds placeable.
+TEST_F(ResolvedOptions, OneCycleAheadIsTheDefaultWhereEveryCyclesFrameIsThere) {
+  const CalibrateOptions o;
+  const TrajectoryReader six(store(false, 0, 6));  // the default window: cycles 1-6
+  const CalibrateOptions ahead = resolved_options(o, six);
+  EXPECT_TRUE(ahead.ahead());
+  EXPECT_EQ(ahead.refine, 0);  // its packing ahead, not the refined packings
+  EXPECT_NO_THROW(ahead.validate());
+  const auto resolved = [&](CalibrateOptions given, const TrajectoryReader& experiment) {
+    return resolved_options(given, experiment);
+  };
+  // The window fit: a window of 4 cycles, or the main job's 3.
+  CalibrateOptions four = o;
+  four.window = std::pair<std::int64_t, std::int64_t>{3, 6};
+  EXPECT_FALSE(resolved(four, six).ahead());
+  EXPECT_EQ(resolved(four, six).refine, 4);
+  EXPECT_FALSE(resolved(o, TrajectoryReader(store(false, 0, 3))).ahead());
+  four.window->first = 2;  // five: ahead
+  EXPECT_TRUE(resolved(four, six).ahead());
+  // A frame missing in the window (2-6), or the one before it: the cycles that have theirs
+  // compared, too few for the default.
+  const TrajectoryReader gap(store(false, 0, 6, 4));
+  EXPECT_EQ(comparable_ahead_cycles(gap, {2, 6}, 0), (std::vector<std::int64_t>{2, 3, 6}));
+  EXPECT_EQ(comparable_ahead_cycles(gap, {2, 6}, 1), (std::vector<std::int64_t>{2, 3}));
+  EXPECT_EQ(comparable_ahead_cycles(gap, {1, 6}, 1), (std::vector<std::int64_t>{2, 3}));
+  EXPECT_FALSE(resolved(four, gap).ahead());
+  EXPECT_FALSE(resolved(four, TrajectoryReader(store(false, 0, 6, 1))).ahead());
+  // Fine scans are placed (ahead); coarse ones poured (the window fit).
+  EXPECT_TRUE(resolved(o, TrajectoryReader(store(true, 5e-6, 6))).ahead());
+  EXPECT_FALSE(resolved(o, TrajectoryReader(store(true, 25e-6, 6))).ahead());
+  // What the caller asks of the window fit keeps it.
+  CalibrateOptions asked = o;
+  asked.refine = 2;
+  EXPECT_FALSE(resolved(asked, six).ahead());
+  asked = o;
+  asked.placed_cycle = 0;
+  EXPECT_FALSE(resolved(asked, six).ahead());
+  asked = o;
+  asked.one_cycle_ahead = false;
+  EXPECT_FALSE(resolved(asked, six).ahead());
+  EXPECT_EQ(resolved(asked, six).refine, 4);
+  asked = o;
+  asked.mu_r = {0.004, 0.012, 0.036};  // the joint fit
+  EXPECT_FALSE(resolved(asked, six).ahead());
+  asked = o;
+  asked.observables = CalibrationObservables::displacements;
+  EXPECT_FALSE(resolved(asked, six).ahead());
 }
 
 // A placed twin starts before the window; from scans, at their first frame, the preparation,

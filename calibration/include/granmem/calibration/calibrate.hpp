@@ -51,6 +51,10 @@ inline constexpr double kPlacedJitterDiameters = 1e-4;
 // (the end-of-cycle displacement bends most, and a line through +-15 % read it 7 % high at
 // 0.46), and wide enough to hold the truth where the design's fit is off by 10 %.
 inline constexpr double kOneCycleAheadSpan[] = {1 / 1.2, 1 / 1.07, 1.07, 1.2};
+// CalibrateOptions::one_cycle_ahead left to calibrate: on for windows of this many cycles or
+// more (fewer cycles' scatter is a poor error: Student's t for 3 dof is 3.2, and the window
+// fit of the main job's 3 cycles is sharper).
+inline constexpr std::int64_t kOneCycleAheadByDefault = 5;
 // The preparation's name in options, the summary and the runs' parameters.
 const char* preparation_name(TwinPreparation preparation);
 // Its name read back (each, shared, experiment, auto); Error naming `option` otherwise.
@@ -138,8 +142,18 @@ struct CalibrateOptions {
   // twin starts each cycle where the experiment did, so the experiment's chaos over the
   // window is not compared, only what one cycle does from where it was. Needs the
   // experiment's frame of every cycle from the window's first - 1 to its last, and a window
-  // of 3 cycles or more; implies fit_only (no comparison run).
-  bool one_cycle_ahead = false;
+  // of 3 cycles or more; implies fit_only (no comparison run). Unset (auto): on for a
+  // placed twin fitting mu_s whose refinement, placed cycle and window are left to it (or
+  // the window given), over a window of kOneCycleAheadByDefault cycles or more whose every
+  // cycle and the one before it the experiment has a placeable frame of; else the window
+  // fit (resolved_options()).
+  std::optional<bool> one_cycle_ahead;
+  bool ahead() const { return one_cycle_ahead.value_or(false); }
+  // One cycle ahead: the cycles each of its runs drives before the one compared, placed from
+  // the experiment's frame that many cycles earlier. The placed packing's contacts start
+  // with no tangential history, and one cycle loads them again (docs/CALIBRATION.md,
+  // "One cycle ahead").
+  int ahead_burn_in = 1;
   // Steady state: packings added about the design's fit (mu_s, or mu_s and mu_r jointly; at
   // refined_mu_s()), each its own seed (seed + replicas, ...), then the fit made again on every
   // run. They measure one packing's scatter where the experiment is, as realizations
@@ -204,6 +218,11 @@ std::int64_t placed_cycle_for(const CalibrateOptions& options, const TrajectoryR
 // The preparation `options` ask for, automatic resolved for `experiment`.
 TwinPreparation resolved_preparation(const CalibrateOptions& options,
                                      const TrajectoryReader& experiment);
+// The window's cycles one cycle ahead can compare: those the experiment has a placeable
+// frame of `burn_in` + 1 cycles before, and the frame of every cycle from there to it.
+std::vector<std::int64_t> comparable_ahead_cycles(const TrajectoryReader& experiment,
+                                                  std::pair<std::int64_t, std::int64_t> window,
+                                                  int burn_in);
 // The options calibrate() runs: the twin's protocol settings not in twin_given taken from a
 // pseudo-experiment's store, the preparation resolved for `experiment`, then the design
 // where `given` leaves it (with_default_design(): a placed twin's own).

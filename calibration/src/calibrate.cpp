@@ -1791,7 +1791,7 @@ void write_one_cycle_ahead_summary(const Twin& twin, const SegmentedFit& fit,
 // interval and a pseudo-experiment's truth), and each observable's runs less the
 // experiment's of their cycle against mu_s, with the cycles' mean trend through them.
 std::vector<fs::path> one_cycle_ahead_figures(const fs::path& out, const SegmentedFit& fit,
-                                              const std::vector<std::int64_t>& cycles,
+                                              const std::vector<std::int64_t>& cycles, int burn_in,
                                               double true_mu_s) {
   std::vector<double> x, error;
   for (std::size_t k = 0; k < cycles.size(); ++k) {
@@ -1800,7 +1800,9 @@ std::vector<fs::path> one_cycle_ahead_figures(const fs::path& out, const Segment
   }
   std::vector<fs::path> written = plot_fits_apart(
       out, "one_cycle_ahead_cycles", x, fit.segment_mu_s, error, fit.mu_s, fit.mu_s_ci95, true_mu_s,
-      "cycle (the twin placed from the experiment's frame before it)",
+      burn_in ? "cycle (the twin placed from the experiment's frame " +
+                    std::to_string(burn_in + 1) + " cycles before it)"
+              : std::string("cycle (the twin placed from the experiment's frame before it)"),
       "one cycle ahead: each cycle's own fit (its GLS error)");
   std::vector<ObservablePanel> panels;
   for (std::size_t o = 0; o < fit.names.size(); ++o) {
@@ -1874,7 +1876,8 @@ void fit_one_cycle_ahead(const Twin& twin, const std::vector<FrictionRunSpec>& d
   s.simulations = s.simulations_fitted = design.size() + mu.size();
   write_one_cycle_ahead_summary(twin, fit, cycles, mu, first.line, s);
   s.written.push_back(o.out / "summary.json");
-  const std::vector<fs::path> figures = one_cycle_ahead_figures(o.out, fit, cycles, s.true_mu_s);
+  const std::vector<fs::path> figures =
+      one_cycle_ahead_figures(o.out, fit, cycles, o.ahead_burn_in, s.true_mu_s);
   s.written.insert(s.written.end(), figures.begin(), figures.end());
   report_one_cycle_ahead(twin, fit, cycles, s, design_edge_note(fit.mu_s, segments.front().runs),
                          report);

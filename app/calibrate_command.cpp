@@ -158,11 +158,11 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
   cmd->add_flag("--one-cycle-ahead", args->one_cycle_ahead,
                 "steady-state, placed twin, mu_s: after the design's fit, one packing more at "
                 "fit/1.2, fit/1.07, fit x 1.07 and fit x 1.2, placed anew from the experiment's "
-                "frame of every cycle before one of the window and driven that one cycle; the fit "
-                "the mean of the cycles' own, its error their scatter (no refined packings, no "
-                "comparison run; docs/CALIBRATION.md, \"One cycle ahead\"); the default where "
-                "the experiment has a frame of every cycle of a window of 5 or more and the one "
-                "before it, and --refine, --placed-cycle and --window auto are not given");
+                "frame --ahead-burn-in + 1 cycles before each of the window's cycles and driven "
+                "to it; the fit the mean of the cycles' own, its error their scatter (no refined "
+                "packings, no comparison run; docs/CALIBRATION.md, \"One cycle ahead\"); the "
+                "default where 5 or more of the window's cycles have those frames, and --refine, "
+                "--placed-cycle and --window auto are not given");
   cmd->add_flag("--window-fit", args->window_fit,
                 "steady-state: fit the window's means (the design, its refined packings), not "
                 "one cycle ahead, where that would be the default")

@@ -135,18 +135,17 @@ struct CalibrateOptions {
   std::optional<std::int64_t> placed_cycle;
   bool fit_only = false;  // steady state: no run at the fitted friction, so no comparison
   // Steady state, a placed twin, mu_s alone: after the design's fit, one packing more at
-  // kOneCycleAheadSpan x that fit, placed anew from the experiment's frame of every cycle
-  // before one of the window and driven that one cycle (each cycle a segment, its runs in
-  // out/ahead/cycle_<c>/runs), instead of the refined packings; the fit is the mean of the
-  // segments' own (fit_friction_by_segments(), docs/CALIBRATION.md, "One cycle ahead"): the
-  // twin starts each cycle where the experiment did, so the experiment's chaos over the
-  // window is not compared, only what one cycle does from where it was. Needs the
-  // experiment's frame of every cycle from the window's first - 1 to its last, and a window
-  // of 3 cycles or more; implies fit_only (no comparison run). Unset (auto): on for a
-  // placed twin fitting mu_s whose refinement, placed cycle and window are left to it (or
-  // the window given), over a window of kOneCycleAheadByDefault cycles or more whose every
-  // cycle and the one before it the experiment has a placeable frame of; else the window
-  // fit (resolved_options()).
+  // kOneCycleAheadSpan x that fit, placed anew from the experiment's frame before each of
+  // the window's cycles (ahead_burn_in earlier) and driven to it (each cycle a segment, its
+  // runs in out/ahead/cycle_<c>[_from_<c - 1 - burn-in>]/runs), instead of the refined packings;
+  // the fit is the mean of the segments' own (fit_friction_by_segments(), docs/CALIBRATION.md, "One
+  // cycle ahead"): the twin starts each cycle where the experiment did, so the experiment's chaos
+  // over the window is not compared, only what one cycle does from where it was. Compares the
+  // window's cycles that comparable_ahead_cycles() finds (each run placed ahead_burn_in + 1
+  // cycles before its cycle), 3 or more; implies fit_only (no comparison run). Unset
+  // (auto): on for a placed twin fitting mu_s whose refinement, placed cycle and window
+  // are left to it (or the window given) where kOneCycleAheadByDefault or more of the
+  // window's cycles are comparable; else the window fit (resolved_options()).
   std::optional<bool> one_cycle_ahead;
   bool ahead() const { return one_cycle_ahead.value_or(false); }
   // One cycle ahead: the cycles each of its runs drives before the one compared, placed from

@@ -575,6 +575,8 @@ TEST_F(Calibrate, FitsOneCycleAheadFromEveryCyclesFrame) {
   // Cycle 1 would need a frame of cycle -1.
   bad = calibrate({"--window", "1:3", "--mu-s", "0.1,0.2,0.4", "--one-cycle-ahead"});
   expect_clean_failure(bad, {"--one-cycle-ahead", "2 of the window's cycles 1-3"});
+  bad = calibrate({"--window", "1:3", "--mu-s", "0.1,0.2,0.4", "--ahead-burn-in", "-1"});
+  expect_clean_failure(bad, {"--ahead-burn-in", "0 or more"});
 }
 
 // Left to it, calibrate fits one cycle ahead where the experiment has every cycle's frame over

@@ -35,7 +35,7 @@ void add_calibrate(CLI::App& app, const SimulateSettings& simulate) {
                                                observables = "steady-state", only, fit = "mu_s";
     std::map<std::string, std::string> twin;
     bool subtract_drift = true, fit_only = false, one_cycle_ahead = false, window_fit = false;
-    int ahead_burn_in = 1;
+    int ahead_burn_in = CalibrateOptions{}.ahead_burn_in;
     int threads = 0, degree = 0, replicas = 0, refine = -1;
     std::string axis_noise = "auto", placed_jitter = "auto", placed_cycle = "auto";
     std::string true_mu_s, true_mu_r;

@@ -933,9 +933,9 @@ PYBIND11_MODULE(_granmem, m) {
         py::arg("refine") = py::none(), py::arg("axis_noise") = "auto", py::arg("deposit") = "auto",
         py::arg("placed_jitter") = "auto", py::arg("placed_cycle") = "auto",
         py::arg("fit_only") = false, py::arg("one_cycle_ahead") = py::none(),
-        py::arg("ahead_burn_in") = 1, py::arg("true_mu_s") = py::none(),
-        py::arg("true_mu_r") = py::none(), py::arg("parallel") = 0, py::arg("twin") = py::dict(),
-        py::arg("progress") = py::none());
+        py::arg("ahead_burn_in") = CalibrateOptions{}.ahead_burn_in,
+        py::arg("true_mu_s") = py::none(), py::arg("true_mu_r") = py::none(),
+        py::arg("parallel") = 0, py::arg("twin") = py::dict(), py::arg("progress") = py::none());
   m.def("compare", &compare_py, py::arg("a"), py::arg("b"), py::arg("out"),
         py::arg("window") = py::none(), py::arg("diameter") = py::none(),
         py::arg("label_a") = CompareOptions{}.label_a,
